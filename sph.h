@@ -1,0 +1,2668 @@
+/* sph.h - smoothed particle hydrodynamics in one header. MIT licence (see end of file).
+@@DOCS@@
+*/
+/* ============================================================================================== */
+/* >>config                                                                                       */
+/* ============================================================================================== */
+#ifndef SPH_H
+#define SPH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#define SPH_VERSION_MAJOR 0
+#define SPH_VERSION_MINOR 1
+#define SPH_VERSION_PATCH 0
+
+#ifndef SPHDEF
+#ifdef SPH_STATIC
+#if defined(__GNUC__) || defined(__clang__)
+#define SPHDEF static __attribute__((unused))
+#else
+#define SPHDEF static
+#endif
+#else
+#define SPHDEF extern
+#endif
+#endif
+
+#ifdef SPH_FLOAT
+typedef float sph_real;
+#else
+typedef double sph_real;
+#endif
+
+/* Largest number of phases (materials) in one world. */
+#ifndef SPH_MAX_PHASES
+#define SPH_MAX_PHASES 16
+#endif
+
+/* Size of the error message buffer kept in the world. */
+#define SPH_ERROR_SIZE 256
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ============================================================================================== */
+/* >>types                                                                                        */
+/* ============================================================================================== */
+
+/* Result of every function that can fail. The world keeps the detail in w.error. */
+typedef enum sph_status {
+    SPH_OK = 0,
+    SPH_ERR_ARG,           /* an argument or a def field is invalid; nothing was changed       */
+    SPH_ERR_NOMEM,         /* an allocation failed; the world is unchanged and still usable     */
+    SPH_ERR_CAPACITY,      /* a count exceeds what the library can index (2^32-1 particles)     */
+    SPH_ERR_UNSTABLE,      /* a step produced a non-finite value or a runaway density/speed     */
+    SPH_ERR_NOT_CONVERGED, /* an iterative solver reached its iteration limit                   */
+    SPH_STATUS_COUNT
+} sph_status;
+
+SPHDEF const char* sph_status_string(sph_status status);
+
+/* ============================================================================================== */
+/* >>kernels                                                                                      */
+/* ============================================================================================== */
+
+typedef enum sph_kernel_type {
+    SPH_KERNEL_WENDLAND_C2 = 0, /* default: Wendland C2, support 2h                              */
+    SPH_KERNEL_CUBIC,           /* Monaghan's cubic B-spline (M4), support 2h                     */
+    SPH_KERNEL_QUINTIC,         /* Morris' quintic B-spline (M6), support 3h                      */
+    SPH_KERNEL_WENDLAND_C4,     /* Wendland C4, support 2h                                        */
+    SPH_KERNEL_WENDLAND_C6,     /* Wendland C6, support 2h                                        */
+    SPH_KERNEL_GAUSSIAN,        /* Gaussian truncated at 3h, shifted to vanish there, renormalised */
+    SPH_KERNEL_COUNT
+} sph_kernel_type;
+
+/* A kernel bound to a dimension and smoothing length. Plain data: copy it freely. */
+typedef struct sph_kernel {
+    sph_kernel_type type;
+    int dim;         /* 1, 2 or 3                                                       */
+    sph_real h;      /* smoothing length [m]                                            */
+    sph_real radius; /* support radius [m] = support factor (2 or 3) * h                */
+    /* derived constants (read-only) */
+    int form;        /* private: polynomial variant (Wendland kernels differ in 1D)       */
+    sph_real inv_h;
+    sph_real norm_w; /* sigma_d / h^d     : W(r) = norm_w * w(r/h)                       */
+    sph_real norm_g; /* sigma_d / h^(d+2) : grad W = norm_g * f(r/h) * x_ij              */
+} sph_kernel;
+
+/* Fills k for the given type, dimension (1..3) and smoothing length h > 0 [m]. */
+SPHDEF sph_status sph_kernel_init(sph_kernel* k, sph_kernel_type type, int dim, sph_real h);
+/* Support radius in units of h: 2 (cubic, Wendland) or 3 (quintic, Gaussian). */
+SPHDEF sph_real sph_kernel_support(sph_kernel_type type);
+/* Recommended h / particle spacing for the type (used when sph_world_def.h_factor is 0). */
+SPHDEF sph_real sph_kernel_default_h_factor(sph_kernel_type type);
+SPHDEF const char* sph_kernel_name(sph_kernel_type type);
+/* W(r) [1/m^dim] for a distance r >= 0 [m]. */
+SPHDEF sph_real sph_kernel_w(const sph_kernel* k, sph_real r);
+/* dW/dr [1/m^(dim+1)]. */
+SPHDEF sph_real sph_kernel_dwdr(const sph_kernel* k, sph_real r);
+/* grad_i W(x_i - x_j): xij = x_i - x_j (k->dim components) -> grad (k->dim components). */
+SPHDEF void sph_kernel_grad(const sph_kernel* k, const sph_real* xij, sph_real* grad);
+
+/* ============================================================================================== */
+/* >>grid                                                                                         */
+/* ============================================================================================== */
+
+/* Uniform cell grid for fixed-radius neighbour search over a point set. Cells are addressed
+   through a dense table over the points' bounding box when that box is small, and through a
+   hash table otherwise, so a point far away costs no memory. Periodic directions wrap. */
+typedef struct sph_grid {
+    int dim;
+    sph_real cell;        /* cell edge [m]; queries may use any radius <= cell               */
+    int periodic[3];      /* nonzero: direction k wraps over [lo[k], lo[k] + len[k])          */
+    sph_real lo[3];       /* periodic box origin [m]                                          */
+    sph_real len[3];      /* periodic box length [m]                                          */
+    /* filled by sph_grid_build (read-only) */
+    size_t n;             /* points in the last build                                         */
+    uint32_t* order;      /* [n] the k-th point in cell order is point order[k]               */
+    uint32_t* start;      /* [nbucket + 1] bucket b holds sorted positions start[b]..start[b+1]) */
+    uint64_t* key;        /* [n] hash mode only: packed cell of the k-th sorted point         */
+    size_t nbucket;
+    int hashed;           /* 0: dense bounding-box table, 1: hash table                       */
+    /* private */
+    sph_real inv[3];      /* 1 / cell edge per direction (periodic directions divide len)     */
+    int32_t ncell[3];     /* cells along periodic directions                                  */
+    int64_t cmin[3], ext[3];
+    uint32_t* bucket;     /* [n] scratch: bucket of each point                                */
+    size_t cap_n, cap_bucket;
+} sph_grid;
+
+/* Sets up an empty grid. cell_size >= the largest query radius [m]. periodic may be NULL (no
+   direction periodic); lo/hi give the periodic box and are read only for periodic directions,
+   whose length must be at least 2 * cell_size. */
+SPHDEF sph_status sph_grid_init(sph_grid* g, int dim, sph_real cell_size, const int* periodic,
+                                const sph_real* lo, const sph_real* hi);
+SPHDEF void sph_grid_free(sph_grid* g);
+/* Sorts n points x[i*dim + k] into cells (counting sort). x must stay valid for queries. */
+SPHDEF sph_status sph_grid_build(sph_grid* g, const sph_real* x, size_t n);
+/* Indices of the built points within radius (< radius, radius <= cell) of point p. Writes at most
+   cap indices to out and returns the total number found (compare with cap). */
+SPHDEF size_t sph_grid_query(const sph_grid* g, const sph_real* x, const sph_real* p,
+                             sph_real radius, uint32_t* out, size_t cap);
+/* d = a - b, with the minimum-image convention along periodic directions. */
+SPHDEF void sph_grid_delta(const sph_grid* g, const sph_real* a, const sph_real* b, sph_real* d);
+
+/* Neighbour lists in compressed rows: the neighbours of query point i are
+   idx[begin[i]] .. idx[begin[i] + count[i] - 1], in a deterministic order. */
+typedef struct sph_neighbors {
+    size_t n;            /* query points                                                      */
+    size_t* begin;       /* [n]                                                               */
+    uint32_t* count;     /* [n]                                                               */
+    uint32_t* idx;       /* neighbour indices into the grid's point set                        */
+    size_t total;        /* sum of count                                                      */
+    /* private: lists are filled in chunks of query points, each with its own region of idx */
+    size_t cap_n, cap_idx, nchunk, cap_chunk;
+    size_t* chunk_off;
+    size_t* chunk_cap;
+    size_t* chunk_need;
+} sph_neighbors;
+
+/* Builds the lists of all grid points within radius of each query point xq[i*dim + k].
+   x is the array the grid was built on. exclude_self: xq is that same point set, and a point is
+   not listed as its own neighbour. Memory is reused between builds and grows only when needed. */
+SPHDEF sph_status sph_neighbors_build(sph_neighbors* nl, const sph_grid* g, const sph_real* x,
+                                      const sph_real* xq, size_t nq, sph_real radius,
+                                      int exclude_self);
+SPHDEF void sph_neighbors_free(sph_neighbors* nl);
+
+/* ============================================================================================== */
+/* >>world                                                                                        */
+/* ============================================================================================== */
+
+typedef enum sph_solver {
+    SPH_SOLVER_WCSPH = 0 /* weakly compressible SPH with an equation of state                 */
+} sph_solver;
+
+typedef enum sph_density {
+    SPH_DENSITY_CONTINUITY = 0, /* d rho_i/dt = sum_j m_j v_ij . grad W_ij   (default)            */
+    SPH_DENSITY_SUMMATION,      /* rho_i = sum_j m_j W_ij                                         */
+    SPH_DENSITY_PARTICLE        /* Ott-Schnetter: d rho_i/dt = m_i sum_j v_ij . grad W_ij (eq. 11) */
+} sph_density;
+
+typedef enum sph_pressure_grad {
+    SPH_PGRAD_SYMMETRIC = 0, /* sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W_ij  (default)        */
+    SPH_PGRAD_MULTIPHASE     /* sum_j m_j (p_i + p_j)/(rho_i rho_j) grad W_ij (large density ratios) */
+} sph_pressure_grad;
+
+typedef enum sph_integrator {
+    SPH_INTEGRATOR_SYMPLECTIC_EULER = 0, /* kick-drift, one force evaluation (default)         */
+    SPH_INTEGRATOR_VERLET                /* Stormer-Verlet drift-kick-drift, second order       */
+} sph_integrator;
+
+typedef enum sph_wall {
+    SPH_WALL_FREE_SLIP = 0, /* no viscous interaction with wall particles (default)             */
+    SPH_WALL_NO_SLIP        /* viscous terms use Adami's extrapolated wall velocity             */
+} sph_wall;
+
+typedef enum sph_pressure_clamp {
+    SPH_CLAMP_AUTO = 0, /* clamp negative pressure with summation density only (default)         */
+    SPH_CLAMP_ON,       /* p = max(p, 0): no tension (free surfaces without a background pressure) */
+    SPH_CLAMP_OFF       /* negative pressures act as tension                                     */
+} sph_pressure_clamp;
+
+typedef enum sph_eos {
+    SPH_EOS_TAIT = 0, /* p = B((rho/rho0)^gamma - 1) + p_b, B = rho0 c0^2 / gamma (default)       */
+    SPH_EOS_LINEAR    /* p = c0^2 (rho - rho0) + p_b                                            */
+} sph_eos;
+
+/* Faces of an axis-aligned box, for sph_add_wall_box's open_faces. */
+enum {
+    SPH_FACE_XMIN = 1, SPH_FACE_XMAX = 2, SPH_FACE_YMIN = 4,
+    SPH_FACE_YMAX = 8, SPH_FACE_ZMIN = 16, SPH_FACE_ZMAX = 32
+};
+
+/* Stages whose time is measured in w.stats.stage_time. */
+typedef enum sph_stage {
+    SPH_STAGE_BOUNDARY = 0, /* boundary motion callback                                         */
+    SPH_STAGE_NEIGHBORS,    /* sort by cell, grids, neighbour lists                              */
+    SPH_STAGE_DENSITY,      /* summation density or density rate                                */
+    SPH_STAGE_PRESSURE,     /* equation of state, wall pressure extrapolation                    */
+    SPH_STAGE_FORCES,       /* pressure, viscous, body and user accelerations                    */
+    SPH_STAGE_INTEGRATE,    /* time integration, diagnostics, blow-up detection                  */
+    SPH_STAGE_COUNT
+} sph_stage;
+
+struct sph_world;
+
+/* Adds accelerations [m/s^2] of fluid particles begin..end-1 to acc[i*dim + k]. Called from
+   worker threads with disjoint ranges while a step runs; it may read the world (positions,
+   velocities, densities, pressures are those the step's forces use) and must write only
+   acc[i*dim + k] for i in its range. */
+typedef void (*sph_force_fn)(const struct sph_world* w, size_t begin, size_t end, sph_real* acc,
+                             void* user);
+
+/* Kinematic boundary motion. Called once per step, on the calling thread, before the neighbour
+   search, with the time [s] at which the step evaluates forces. It sets w->b_x and w->b_v for
+   the boundary particles it moves (identify them by w->b_body, w->b_id or the reference position
+   w->b_x0) and may set w->b_a (wall acceleration, used by the pressure extrapolation). */
+typedef void (*sph_boundary_fn)(struct sph_world* w, double time, void* user);
+
+typedef struct sph_world_def {
+    int dim;                   /* 1, 2 or 3 (set by sph_world_def_default)                         */
+    sph_real spacing;          /* particle spacing dx [m]; default 0.01; > 0                      */
+    sph_real h_factor;         /* h = h_factor * dx; 0 (default) = kernel's recommended value     */
+    sph_kernel_type kernel;    /* default SPH_KERNEL_WENDLAND_C2                                  */
+    sph_real gravity[3];       /* [m/s^2]; default (0, -9.81, 0) in 2D/3D (y is up), 0 in 1D      */
+    sph_solver solver;         /* used by sph_step / sph_advance; default SPH_SOLVER_WCSPH        */
+    sph_density density;       /* default SPH_DENSITY_CONTINUITY                                  */
+    sph_pressure_grad pressure_grad; /* default SPH_PGRAD_SYMMETRIC                               */
+    sph_integrator integrator; /* default SPH_INTEGRATOR_SYMPLECTIC_EULER                         */
+    sph_pressure_clamp clamp;  /* default SPH_CLAMP_AUTO: summation density sees a deficit at a
+                                  free surface, so its negative pressures would pull the surface
+                                  into the fluid (Becker & Teschner 2007 clamp them)             */
+    sph_real delta;            /* delta-SPH density diffusion coefficient; default 0.1; [0, 1]    */
+    sph_real alpha;            /* Monaghan artificial viscosity alpha; default 0.02; [0, 10]      */
+    sph_real beta;             /* Monaghan artificial viscosity beta; default 0; [0, 10]          */
+    sph_wall wall;             /* default SPH_WALL_FREE_SLIP                                      */
+    sph_real cfl;              /* acoustic CFL number for sph_stable_dt; default 0.25; (0, 1]     */
+    sph_real cfl_viscous;      /* viscous limit dt <= cfl_viscous h^2 / nu; default 0.125         */
+    sph_real cfl_force;        /* force limit dt <= cfl_force sqrt(h / |a|); default 0.25         */
+    sph_real domain_lo[3];     /* [m] domain box; particles outside are counted in                */
+    sph_real domain_hi[3];     /*     w.stats.n_outside. lo == hi in a direction: unbounded there  */
+    int periodic[3];           /* nonzero: direction wraps over [domain_lo, domain_hi)            */
+    sph_real max_compression;  /* blow-up if rho/rho0 - 1 exceeds it; default 0.2; 0 = no check  */
+    sph_real max_speed;        /* blow-up if |v| exceeds it [m/s]; 0 (default) = the largest c0   */
+    sph_force_fn force;        /* optional external accelerations                                 */
+    void* force_user;
+    sph_boundary_fn boundary_motion; /* optional moving boundary particles                       */
+    void* boundary_user;
+} sph_world_def;
+
+/* A material. Zero fields take the documented defaults, so a compound literal with only the rest
+   density is a complete phase. */
+typedef struct sph_phase {
+    sph_real rest_density;   /* rho0 [kg/m^3]; required, > 0                                      */
+    sph_real viscosity;      /* kinematic viscosity nu [m^2/s]; 0 = inviscid (default)            */
+    sph_real sound_speed;    /* c0 [m/s]; 0 = automatic: 10 * max(sqrt(2 |g| H), |v|max) at the
+                                first step, H = height of the phase's particles along gravity     */
+    sph_eos eos;             /* default SPH_EOS_TAIT                                              */
+    sph_real gamma;          /* Tait exponent; 0 = 7                                              */
+    sph_real back_pressure;  /* p_b added by the equation of state [Pa]; default 0                */
+    sph_real mass;           /* particle mass [kg]; 0 = rest_density * dx^dim                     */
+} sph_phase;
+
+/* Diagnostics of the last step. */
+typedef struct sph_stats {
+    double dt;                /* [s]                                                              */
+    int iterations;           /* solver iterations (1 for WCSPH)                                   */
+    double density_error_avg; /* mean |rho/rho0 - 1| over fluid particles                          */
+    double density_error_max; /* max |rho/rho0 - 1|                                               */
+    double v_max;             /* [m/s]                                                             */
+    double a_max;             /* largest acceleration of the step [m/s^2]                          */
+    double kinetic_energy;    /* sum 1/2 m |v|^2 [J]                                               */
+    size_t pairs;             /* fluid-fluid neighbour pairs (each counted from both sides)         */
+    size_t n_outside;         /* fluid particles outside the domain box (kept, still simulated)    */
+    double stage_time[SPH_STAGE_COUNT]; /* wall-clock seconds per stage                            */
+    double step_time;         /* wall-clock seconds of the whole step                              */
+} sph_stats;
+
+/* Private state (do not touch). */
+typedef struct sph__private {
+    sph_grid grid, bgrid;           /* fluid and boundary grids (same cells)                       */
+    sph_neighbors ff, fb, bf;       /* fluid->fluid, fluid->boundary, boundary->fluid              */
+    uint8_t* perm_buf;              /* permutation scratch, capacity * largest element              */
+    size_t perm_cap;                /* bytes                                                        */
+    uint32_t* b_order;              /* boundary order scratch                                       */
+    double* block;                  /* per-block partial reductions                                 */
+    size_t block_cap;
+    sph_real* rho_n;                /* Verlet: density at the start of the step (scratch)          */
+    size_t rho_n_cap;
+    int b_dirty;                    /* boundary particles changed since the last boundary grid     */
+    sph_real mass;                  /* mass of every particle while w->m is NULL                   */
+    int have_mass;
+} sph__private;
+
+/* The world: a caller-owned plain struct. Read the arrays directly; positions and velocities may
+   be written between steps. Particles are reordered by cell at every step: follow a particle by
+   its id, not by its index. Array pointers change only when particles are added. */
+typedef struct sph_world {
+    sph_world_def def;         /* validated copy of the def                                        */
+    int dim;
+    sph_real dx;               /* particle spacing [m]                                             */
+    sph_real h;                /* smoothing length [m]                                             */
+    sph_kernel kernel;
+    sph_phase phases[SPH_MAX_PHASES];
+    int nphase;
+    double time;               /* simulated time [s]                                               */
+    uint64_t steps;            /* steps taken                                                      */
+
+    /* fluid particles, i = 0 .. n-1 */
+    size_t n, capacity;
+    sph_real* x;               /* [n*dim] position [m]                                             */
+    sph_real* v;               /* [n*dim] velocity [m/s]                                           */
+    sph_real* rho;             /* [n] density [kg/m^3]                                             */
+    sph_real* p;               /* [n] pressure [Pa]                                                */
+    sph_real* m;               /* [n] mass [kg]; NULL while every particle of a phase has its mass  */
+    uint32_t* id;              /* [n] stable identity                                              */
+    uint8_t* phase;            /* [n] phase index                                                  */
+    sph_real* a;               /* [n*dim] acceleration of the last step [m/s^2] (scratch)          */
+    sph_real* drho;            /* [n] density rate [kg/m^3/s] (scratch)                            */
+    uint32_t next_id;
+
+    /* boundary particles, b = 0 .. nb-1 */
+    size_t nb, b_capacity;
+    sph_real* b_x;             /* [nb*dim] position [m]                                            */
+    sph_real* b_v;             /* [nb*dim] velocity [m/s]                                          */
+    sph_real* b_a;             /* [nb*dim] acceleration [m/s^2] (set by the motion callback)       */
+    sph_real* b_x0;            /* [nb*dim] reference position: where the particle was added [m]    */
+    sph_real* b_vol;           /* [nb] volume [m^dim]                                              */
+    sph_real* b_p;             /* [nb] extrapolated pressure [Pa]                                  */
+    sph_real* b_rho;           /* [nb] extrapolated density relative to rest, rho_b / rho0 [-]      */
+    sph_real* b_vw;            /* [nb*dim] no-slip wall velocity for viscous terms (scratch)       */
+    uint32_t* b_id;            /* [nb] stable identity                                             */
+    uint16_t* b_body;          /* [nb] body tag given when the particle was added                  */
+    uint32_t b_next_id;
+
+    sph_stats stats;
+    sph_status status;         /* status of the last failing call (SPH_OK if none)                 */
+    char error[SPH_ERROR_SIZE];/* message of the last failing call                                 */
+    long error_index;          /* particle index named by the last error, -1 if none              */
+    sph__private priv;
+} sph_world;
+
+/* Defaults for dimension dim (1, 2 or 3); see each field's comment. */
+SPHDEF sph_world_def sph_world_def_default(int dim);
+/* Validates def (a bad field is named in w->error) and sets up an empty world. On failure w is
+   left safe to pass to sph_world_free. */
+SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def);
+SPHDEF void sph_world_free(sph_world* w);
+/* Adds a phase; returns its index, or -1 with the reason in w->error. */
+SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase);
+/* Fills the box [lo, hi] with fluid of the phase on a lattice of spacing dx starting at lo. */
+SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, const sph_real* hi);
+/* Adds n fluid particles at x[i*dim + k] with velocities v (NULL = at rest), density rho0. */
+SPHDEF sph_status sph_add_fluid(sph_world* w, int phase, size_t n, const sph_real* x,
+                                const sph_real* v);
+/* Adds wall particles around the box [lo, hi] (the fluid's container), `layers` deep (0 = enough
+   layers to cover the kernel support). open_faces: SPH_FACE_* bits of faces left open. Body 0. */
+SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_real* hi,
+                                   int layers, unsigned open_faces);
+/* Adds n boundary particles at x with volumes vol [m^dim] (NULL = dx^dim) and a body tag >= 0. */
+SPHDEF sph_status sph_add_boundary(sph_world* w, size_t n, const sph_real* x, const sph_real* vol,
+                                   int body);
+/* Sets density and pressure of all fluid particles to hydrostatic equilibrium under gravity, with
+   zero pressure at the top of each column of fluid (columns of width dx across gravity). */
+SPHDEF sph_status sph_set_hydrostatic(sph_world* w);
+/* The message of the last error (empty if none). */
+SPHDEF const char* sph_world_error(const sph_world* w);
+/* Total fluid mass [kg] and linear momentum [kg m/s] (out[dim]). */
+SPHDEF double sph_world_mass(const sph_world* w);
+SPHDEF void sph_world_momentum(const sph_world* w, double* out);
+
+/* ============================================================================================== */
+/* >>stages                                                                                       */
+/* ============================================================================================== */
+
+/* Largest stable time step [s] for the solver from the CFL (acoustic), viscous and force limits.
+   Returns 0 and sets w->error if it cannot be determined. */
+SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver);
+/* One step of the solver selected in the def. */
+SPHDEF sph_status sph_step(sph_world* w, sph_real dt);
+/* Advances by duration [s] in sub-steps of the stable time step (what a game calls per frame). */
+SPHDEF sph_status sph_advance(sph_world* w, sph_real duration);
+
+/* ============================================================================================== */
+/* >>wcsph                                                                                        */
+/* ============================================================================================== */
+
+/* One weakly compressible step of dt [s]. On SPH_ERR_ARG the world is unchanged. */
+SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt);
+
+/* ============================================================================================== */
+/* >>io                                                                                           */
+/* ============================================================================================== */
+
+/* Fluid particles as CSV: id,phase,x,y[,z],vx,vy[,vz],rho,p. */
+SPHDEF sph_status sph_write_csv(const sph_world* w, const char* path);
+/* Fluid and boundary particles as a legacy ASCII VTK unstructured grid (opens in ParaView). */
+SPHDEF sph_status sph_write_vtk(const sph_world* w, const char* path);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SPH_H */
+
+/* ============================================================================================== */
+/* Implementation                                                                                 */
+/* ============================================================================================== */
+#ifdef SPH_IMPLEMENTATION
+#ifndef SPH__IMPLEMENTATION_ONCE
+#define SPH__IMPLEMENTATION_ONCE
+
+/* >>config (implementation) */
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#if !defined(SPH_MALLOC) && !defined(SPH_REALLOC) && !defined(SPH_FREE)
+#include <stdlib.h>
+#define SPH_MALLOC(size) malloc(size)
+#define SPH_REALLOC(ptr, size) realloc(ptr, size)
+#define SPH_FREE(ptr) free(ptr)
+#elif !defined(SPH_MALLOC) || !defined(SPH_REALLOC) || !defined(SPH_FREE)
+#error "sph.h: define all of SPH_MALLOC, SPH_REALLOC and SPH_FREE, or none"
+#endif
+
+#ifndef SPH_ASSERT
+#include <assert.h>
+#define SPH_ASSERT(c) assert(c)
+#endif
+
+#if defined(_OPENMP)
+#include <omp.h>
+#define SPH__PRAGMA(x) _Pragma(#x)
+#define SPH__OMP_FOR SPH__PRAGMA(omp parallel for schedule(static))
+#define SPH__OMP_FOR_DYNAMIC SPH__PRAGMA(omp parallel for schedule(dynamic, 1))
+#else
+#define SPH__OMP_FOR
+#define SPH__OMP_FOR_DYNAMIC
+#endif
+
+#if defined(_WIN32)
+#ifndef WIN32_LEAN_AND_MEAN
+#define WIN32_LEAN_AND_MEAN
+#endif
+#include <windows.h>
+#elif defined(__unix__) || defined(__APPLE__)
+#include <sys/time.h>
+#else
+#include <time.h>
+#endif
+
+#if defined(__GNUC__) || defined(__clang__)
+#define SPH__INLINE static inline __attribute__((always_inline))
+#elif defined(_MSC_VER)
+#define SPH__INLINE static __forceinline
+#else
+#define SPH__INLINE static inline
+#endif
+
+#define SPH__R(x) ((sph_real)(x))
+typedef ptrdiff_t sph__idx; /* signed loop index for OpenMP */
+
+#ifdef SPH_FLOAT
+SPH__INLINE sph_real sph__sqrt(sph_real x) { return sqrtf(x); }
+SPH__INLINE sph_real sph__exp(sph_real x) { return expf(x); }
+SPH__INLINE sph_real sph__pow(sph_real x, sph_real y) { return powf(x, y); }
+SPH__INLINE sph_real sph__fabs(sph_real x) { return fabsf(x); }
+SPH__INLINE sph_real sph__floor(sph_real x) { return floorf(x); }
+#else
+SPH__INLINE sph_real sph__sqrt(sph_real x) { return sqrt(x); }
+SPH__INLINE sph_real sph__exp(sph_real x) { return exp(x); }
+SPH__INLINE sph_real sph__pow(sph_real x, sph_real y) { return pow(x, y); }
+SPH__INLINE sph_real sph__fabs(sph_real x) { return fabs(x); }
+SPH__INLINE sph_real sph__floor(sph_real x) { return floor(x); }
+#endif
+SPH__INLINE int sph__finite(double x) { return x == x && x - x == 0.0; }
+SPH__INLINE sph_real sph__min(sph_real a, sph_real b) { return a < b ? a : b; }
+SPH__INLINE sph_real sph__max(sph_real a, sph_real b) { return a > b ? a : b; }
+SPH__INLINE size_t sph__maxz(size_t a, size_t b) { return a > b ? a : b; }
+
+static const double sph__pi = 3.14159265358979323846;
+
+static double sph__now(void) {
+#if defined(_OPENMP)
+    return omp_get_wtime();
+#elif defined(_WIN32)
+    LARGE_INTEGER f, c;
+    QueryPerformanceFrequency(&f);
+    QueryPerformanceCounter(&c);
+    return (double)c.QuadPart / (double)f.QuadPart;
+#elif defined(__unix__) || defined(__APPLE__)
+    struct timeval tv;
+    gettimeofday(&tv, NULL);
+    return (double)tv.tv_sec + 1e-6 * (double)tv.tv_usec;
+#else
+    return (double)clock() / (double)CLOCKS_PER_SEC;
+#endif
+}
+
+/* Grows *ptr to hold count elements of elem bytes; keeps *ptr valid on failure. */
+static int sph__grow(void** ptr, size_t count, size_t elem) {
+    void* q;
+    if (count == 0) count = 1;
+    if (count > ((size_t)-1) / elem) return 0;
+    q = SPH_REALLOC(*ptr, count * elem);
+    if (!q) return 0;
+    *ptr = q;
+    return 1;
+}
+
+static sph_status sph__fail(sph_world* w, sph_status s, long index, const char* fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(w->error, SPH_ERROR_SIZE, fmt, ap);
+    va_end(ap);
+    w->status = s;
+    w->error_index = index;
+    return s;
+}
+
+SPHDEF const char* sph_status_string(sph_status status) {
+    switch (status) {
+    case SPH_OK: return "ok";
+    case SPH_ERR_ARG: return "invalid argument";
+    case SPH_ERR_NOMEM: return "out of memory";
+    case SPH_ERR_CAPACITY: return "capacity exceeded";
+    case SPH_ERR_UNSTABLE: return "simulation unstable";
+    case SPH_ERR_NOT_CONVERGED: return "solver did not converge";
+    default: return "unknown status";
+    }
+}
+
+/* ============================================================================================== */
+/* >>kernels (implementation)                                                                     */
+/* ============================================================================================== */
+/* W(r) = sigma_d / h^d * w(q), q = r/h. The private helpers return w(q) and f(q) = w'(q)/q, so
+   grad_i W_ij = sigma_d / h^(d+2) * f(q) * x_ij without dividing by r (f is finite at q = 0).
+   Polynomials and sigma_d: Monaghan 1992 (cubic), Morris 1996 (quintic), Wendland 1995 with the
+   support-2h scaling of Dehnen & Aly 2012 (1D uses Wendland's psi_{3,1}, psi_{5,2}, psi_{7,3};
+   2D/3D psi_{3,1}... of the d = 3 family). The tests integrate every kernel numerically. */
+enum {
+    SPH__KF_CUBIC, SPH__KF_QUINTIC, SPH__KF_WC2, SPH__KF_WC2_1D, SPH__KF_WC4, SPH__KF_WC4_1D,
+    SPH__KF_WC6, SPH__KF_WC6_1D, SPH__KF_GAUSS
+};
+#define SPH__GAUSS_CUT 1.2340980408667956e-4 /* exp(-9): the Gaussian is shifted to vanish at 3h */
+
+SPH__INLINE sph_real sph__kw(int form, sph_real q) {
+    sph_real t, t2;
+    switch (form) {
+    case SPH__KF_CUBIC:
+        if (q < 1) return 1 - SPH__R(1.5) * q * q + SPH__R(0.75) * q * q * q;
+        if (q < 2) { t = 2 - q; return SPH__R(0.25) * t * t * t; }
+        return 0;
+    case SPH__KF_QUINTIC:
+        if (q < 1) { t = q * q; return 66 - 60 * t + 30 * t * t - 10 * t * t * q; }
+        if (q < 2) { t = 3 - q; t2 = 2 - q;
+            return t * t * t * t * t - 6 * t2 * t2 * t2 * t2 * t2; }
+        if (q < 3) { t = 3 - q; return t * t * t * t * t; }
+        return 0;
+    case SPH__KF_WC2:
+        if (q < 2) { t = 1 - SPH__R(0.5) * q; t2 = t * t; return t2 * t2 * (2 * q + 1); }
+        return 0;
+    case SPH__KF_WC2_1D:
+        if (q < 2) { t = 1 - SPH__R(0.5) * q; return t * t * t * (SPH__R(1.5) * q + 1); }
+        return 0;
+    case SPH__KF_WC4:
+        if (q < 2) { t = 1 - SPH__R(0.5) * q; t2 = t * t * t;
+            return t2 * t2 * (SPH__R(35.0 / 12.0) * q * q + 3 * q + 1); }
+        return 0;
+    case SPH__KF_WC4_1D:
+        if (q < 2) { t = 1 - SPH__R(0.5) * q; t2 = t * t;
+            return t2 * t2 * t * (2 * q * q + SPH__R(2.5) * q + 1); }
+        return 0;
+    case SPH__KF_WC6:
+        if (q < 2) { t = 1 - SPH__R(0.5) * q; t2 = t * t; t2 = t2 * t2;
+            return t2 * t2 * (((4 * q + SPH__R(6.25)) * q + 4) * q + 1); }
+        return 0;
+    case SPH__KF_WC6_1D:
+        if (q < 2) { t = 1 - SPH__R(0.5) * q; t2 = t * t; t2 = t2 * t2 * t2 * t;
+            return t2 * (((SPH__R(21.0 / 8.0) * q + SPH__R(4.75)) * q + SPH__R(3.5)) * q + 1); }
+        return 0;
+    case SPH__KF_GAUSS:
+        if (q < 3) return sph__exp(-q * q) - SPH__R(SPH__GAUSS_CUT);
+        return 0;
+    default: return 0;
+    }
+}
+
+SPH__INLINE sph_real sph__kf(int form, sph_real q) {
+    sph_real t, t2;
+    switch (form) {
+    case SPH__KF_CUBIC:
+        if (q < 1) return -3 + SPH__R(2.25) * q;
+        if (q < 2) { t = 2 - q; return SPH__R(-0.75) * t * t / q; }
+        return 0;
+    case SPH__KF_QUINTIC:
+        if (q < 1) return -120 + 120 * q * q - 50 * q * q * q;
+        if (q < 2) { t = 3 - q; t2 = 2 - q;
+            return (-5 * t * t * t * t + 30 * t2 * t2 * t2 * t2) / q; }
+        if (q < 3) { t = 3 - q; return -5 * t * t * t * t / q; }
+        return 0;
+    case SPH__KF_WC2:
+        if (q < 2) { t = 1 - SPH__R(0.5) * q; return -5 * t * t * t; }
+        return 0;
+    case SPH__KF_WC2_1D:
+        if (q < 2) { t = 1 - SPH__R(0.5) * q; return -3 * t * t; }
+        return 0;
+    case SPH__KF_WC4:
+        if (q < 2) { t = 1 - SPH__R(0.5) * q; t2 = t * t;
+            return SPH__R(-14.0 / 3.0) * (1 + SPH__R(2.5) * q) * t2 * t2 * t; }
+        return 0;
+    case SPH__KF_WC4_1D:
+        if (q < 2) { t = 1 - SPH__R(0.5) * q; t2 = t * t;
+            return SPH__R(-3.5) * (1 + 2 * q) * t2 * t2; }
+        return 0;
+    case SPH__KF_WC6:
+        if (q < 2) { t = 1 - SPH__R(0.5) * q; t2 = t * t; t2 = t2 * t2 * t2 * t;
+            return SPH__R(-5.5) * t2 * ((4 * q + SPH__R(3.5)) * q + 1); }
+        return 0;
+    case SPH__KF_WC6_1D:
+        if (q < 2) { t = 1 - SPH__R(0.5) * q; t2 = t * t; t2 = t2 * t2 * t2;
+            return -t2 * ((SPH__R(13.125) * q + SPH__R(13.5)) * q + SPH__R(4.5)); }
+        return 0;
+    case SPH__KF_GAUSS:
+        if (q < 3) return -2 * sph__exp(-q * q);
+        return 0;
+    default: return 0;
+    }
+}
+
+SPHDEF sph_real sph_kernel_support(sph_kernel_type type) {
+    return (type == SPH_KERNEL_QUINTIC || type == SPH_KERNEL_GAUSSIAN) ? SPH__R(3) : SPH__R(2);
+}
+
+SPHDEF sph_real sph_kernel_default_h_factor(sph_kernel_type type) {
+    switch (type) {
+    case SPH_KERNEL_QUINTIC: return SPH__R(1.2); /* seed 002: h = 1.2 dx, support 3.6 dx     */
+    case SPH_KERNEL_GAUSSIAN: return SPH__R(1.0);
+    case SPH_KERNEL_WENDLAND_C4: return SPH__R(1.5);
+    case SPH_KERNEL_WENDLAND_C6: return SPH__R(1.6);
+    default: return SPH__R(1.3); /* cubic, Wendland C2: 21 neighbours in 2D (self included) */
+    }
+}
+
+SPHDEF const char* sph_kernel_name(sph_kernel_type type) {
+    switch (type) {
+    case SPH_KERNEL_WENDLAND_C2: return "wendland_c2";
+    case SPH_KERNEL_CUBIC: return "cubic";
+    case SPH_KERNEL_QUINTIC: return "quintic";
+    case SPH_KERNEL_WENDLAND_C4: return "wendland_c4";
+    case SPH_KERNEL_WENDLAND_C6: return "wendland_c6";
+    case SPH_KERNEL_GAUSSIAN: return "gaussian";
+    default: return "unknown";
+    }
+}
+
+SPHDEF sph_status sph_kernel_init(sph_kernel* k, sph_kernel_type type, int dim, sph_real h) {
+    double sigma = 0, hd, e9 = SPH__GAUSS_CUT, pi = sph__pi;
+    int form = SPH__KF_CUBIC;
+    if (!k || dim < 1 || dim > 3 || !(h > 0) || !sph__finite((double)h) ||
+        (int)type < 0 || type >= SPH_KERNEL_COUNT)
+        return SPH_ERR_ARG;
+    switch (type) {
+    case SPH_KERNEL_CUBIC:
+        form = SPH__KF_CUBIC;
+        sigma = dim == 1 ? 2.0 / 3.0 : dim == 2 ? 10.0 / (7.0 * pi) : 1.0 / pi;
+        break;
+    case SPH_KERNEL_QUINTIC:
+        form = SPH__KF_QUINTIC;
+        sigma = dim == 1 ? 1.0 / 120.0 : dim == 2 ? 7.0 / (478.0 * pi) : 1.0 / (120.0 * pi);
+        break;
+    case SPH_KERNEL_WENDLAND_C2:
+        form = dim == 1 ? SPH__KF_WC2_1D : SPH__KF_WC2;
+        sigma = dim == 1 ? 5.0 / 8.0 : dim == 2 ? 7.0 / (4.0 * pi) : 21.0 / (16.0 * pi);
+        break;
+    case SPH_KERNEL_WENDLAND_C4:
+        form = dim == 1 ? SPH__KF_WC4_1D : SPH__KF_WC4;
+        sigma = dim == 1 ? 3.0 / 4.0 : dim == 2 ? 9.0 / (4.0 * pi) : 495.0 / (256.0 * pi);
+        break;
+    case SPH_KERNEL_WENDLAND_C6:
+        form = dim == 1 ? SPH__KF_WC6_1D : SPH__KF_WC6;
+        sigma = dim == 1 ? 55.0 / 64.0 : dim == 2 ? 39.0 / (14.0 * pi) : 1365.0 / (512.0 * pi);
+        break;
+    case SPH_KERNEL_GAUSSIAN:
+        /* integral of exp(-q^2) - exp(-9) over the ball q < 3 */
+        form = SPH__KF_GAUSS;
+        if (dim == 1) sigma = 1.0 / (sqrt(pi) * erf(3.0) - 6.0 * e9);
+        else if (dim == 2) sigma = 1.0 / (pi * (1.0 - e9) - 9.0 * pi * e9);
+        else sigma = 1.0 / (pow(pi, 1.5) * erf(3.0) - 42.0 * pi * e9);
+        break;
+    default: return SPH_ERR_ARG;
+    }
+    hd = dim == 1 ? (double)h : dim == 2 ? (double)h * (double)h : (double)h * (double)h * (double)h;
+    k->type = type;
+    k->dim = dim;
+    k->h = h;
+    k->radius = sph_kernel_support(type) * h;
+    k->form = form;
+    k->inv_h = 1 / h;
+    k->norm_w = (sph_real)(sigma / hd);
+    k->norm_g = (sph_real)(sigma / (hd * (double)h * (double)h));
+    return SPH_OK;
+}
+
+SPHDEF sph_real sph_kernel_w(const sph_kernel* k, sph_real r) {
+    return k->norm_w * sph__kw(k->form, sph__fabs(r) * k->inv_h);
+}
+
+SPHDEF sph_real sph_kernel_dwdr(const sph_kernel* k, sph_real r) {
+    sph_real q = sph__fabs(r) * k->inv_h;
+    /* dW/dr = norm_g * f(q) * r  (since f = w'/q and norm_g = norm_w / h^2) */
+    return k->norm_g * sph__kf(k->form, q) * sph__fabs(r);
+}
+
+SPHDEF void sph_kernel_grad(const sph_kernel* k, const sph_real* xij, sph_real* grad) {
+    sph_real r2 = 0, s;
+    int d;
+    for (d = 0; d < k->dim; ++d) r2 += xij[d] * xij[d];
+    s = k->norm_g * sph__kf(k->form, sph__sqrt(r2) * k->inv_h);
+    for (d = 0; d < k->dim; ++d) grad[d] = s * xij[d];
+}
+
+/* ============================================================================================== */
+/* >>grid (implementation)                                                                        */
+/* ============================================================================================== */
+/* Cell coordinates are clamped to [-2^20, 2^20): clamping is monotone and moves two points at
+   most as far apart as before, so two points within one cell of each other stay within one cell
+   and no neighbour is missed; points beyond the clamp only share crowded cells. */
+#define SPH__CELL_LIM 1048576
+#define SPH__CHUNK 256 /* query points per neighbour-list chunk */
+
+SPH__INLINE int32_t sph__cell_coord(const sph_grid* g, int k, sph_real xk) {
+    double t;
+    if (g->periodic[k]) {
+        long long c;
+        t = floor((double)(xk - g->lo[k]) * (double)g->inv[k]);
+        if (!(t > -1e15)) t = 0; /* NaN or absurd: any cell; the distance test decides */
+        if (t > 1e15) t = 0;
+        c = (long long)t % (long long)g->ncell[k];
+        if (c < 0) c += g->ncell[k];
+        return (int32_t)c;
+    }
+    t = floor((double)xk * (double)g->inv[k]);
+    if (!(t >= -SPH__CELL_LIM)) t = -SPH__CELL_LIM; /* also catches NaN */
+    if (t > SPH__CELL_LIM - 1) t = SPH__CELL_LIM - 1;
+    return (int32_t)t;
+}
+
+SPH__INLINE uint64_t sph__cell_key(const int32_t* c, int dim) {
+    uint64_t key = 0;
+    int k;
+    for (k = dim - 1; k >= 0; --k) key = (key << 21) | (uint64_t)(uint32_t)(c[k] + SPH__CELL_LIM);
+    return key;
+}
+
+SPH__INLINE uint64_t sph__mix64(uint64_t x) {
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdULL;
+    x ^= x >> 33;
+    x *= 0xc4ceb9fe1a85ec53ULL;
+    x ^= x >> 33;
+    return x;
+}
+
+/* Bucket of cell c, or (size_t)-1 if the cell lies outside the dense table. */
+SPH__INLINE size_t sph__cell_bucket(const sph_grid* g, const int32_t* c, uint64_t key) {
+    if (g->hashed) return (size_t)(sph__mix64(key) & (uint64_t)(g->nbucket - 1));
+    {
+        int64_t lin = 0;
+        int k;
+        for (k = g->dim - 1; k >= 0; --k) {
+            int64_t o = (int64_t)c[k] - g->cmin[k];
+            if (o < 0 || o >= g->ext[k]) return (size_t)-1;
+            lin = lin * g->ext[k] + o;
+        }
+        return (size_t)lin;
+    }
+}
+
+SPH__INLINE sph_real sph__wrap_delta(sph_real d, sph_real len) {
+    return d - len * sph__floor(d / len + SPH__R(0.5));
+}
+
+SPHDEF void sph_grid_delta(const sph_grid* g, const sph_real* a, const sph_real* b, sph_real* d) {
+    int k;
+    for (k = 0; k < g->dim; ++k) {
+        d[k] = a[k] - b[k];
+        if (g->periodic[k]) d[k] = sph__wrap_delta(d[k], g->len[k]);
+    }
+}
+
+SPHDEF sph_status sph_grid_init(sph_grid* g, int dim, sph_real cell_size, const int* periodic,
+                                const sph_real* lo, const sph_real* hi) {
+    int k;
+    if (!g) return SPH_ERR_ARG;
+    memset(g, 0, sizeof(*g));
+    if (dim < 1 || dim > 3 || !(cell_size > 0) || !sph__finite((double)cell_size))
+        return SPH_ERR_ARG;
+    g->dim = dim;
+    g->cell = cell_size;
+    for (k = 0; k < 3; ++k) {
+        g->inv[k] = 1 / cell_size;
+        if (k < dim && periodic && periodic[k]) {
+            sph_real len;
+            if (!lo || !hi || !sph__finite((double)lo[k]) || !sph__finite((double)hi[k]))
+                return SPH_ERR_ARG;
+            len = hi[k] - lo[k];
+            if (!(len >= 2 * cell_size)) return SPH_ERR_ARG;
+            g->periodic[k] = 1;
+            g->lo[k] = lo[k];
+            g->len[k] = len;
+            g->ncell[k] = (int32_t)floor((double)len / (double)cell_size);
+            if (g->ncell[k] > SPH__CELL_LIM) g->ncell[k] = SPH__CELL_LIM;
+            g->inv[k] = (sph_real)g->ncell[k] / len;
+        }
+    }
+    return SPH_OK;
+}
+
+SPHDEF void sph_grid_free(sph_grid* g) {
+    if (!g) return;
+    SPH_FREE(g->order);
+    SPH_FREE(g->start);
+    SPH_FREE(g->key);
+    SPH_FREE(g->bucket);
+    g->order = g->start = g->bucket = NULL;
+    g->key = NULL;
+    g->cap_n = g->cap_bucket = g->n = g->nbucket = 0;
+}
+
+SPHDEF sph_status sph_grid_build(sph_grid* g, const sph_real* x, size_t n) {
+    const int dim = g->dim;
+    int64_t cmin[3] = {0, 0, 0}, cmax[3] = {0, 0, 0};
+    uint64_t cells = 1;
+    size_t b, nbucket;
+    sph__idx i;
+    int k, hashed = 0;
+    if (n > (size_t)UINT32_MAX - 1) return SPH_ERR_CAPACITY;
+    if (n > g->cap_n) {
+        size_t cap = n + n / 4 + 16;
+        if (!sph__grow((void**)&g->order, cap, sizeof(uint32_t)) ||
+            !sph__grow((void**)&g->key, cap, sizeof(uint64_t)) ||
+            !sph__grow((void**)&g->bucket, cap, sizeof(uint32_t)))
+            return SPH_ERR_NOMEM;
+        g->cap_n = cap;
+    }
+    /* bounding box of the cells (a serial min/max pass: cheap and deterministic) */
+    for (k = 0; k < dim; ++k) { cmin[k] = SPH__CELL_LIM; cmax[k] = -SPH__CELL_LIM; }
+    for (i = 0; i < (sph__idx)n; ++i) {
+        for (k = 0; k < dim; ++k) {
+            int32_t c = sph__cell_coord(g, k, x[(size_t)i * (size_t)dim + (size_t)k]);
+            if (c < cmin[k]) cmin[k] = c;
+            if (c > cmax[k]) cmax[k] = c;
+        }
+    }
+    if (n == 0) for (k = 0; k < dim; ++k) cmin[k] = cmax[k] = 0;
+    for (k = 0; k < dim; ++k) {
+        g->cmin[k] = cmin[k];
+        g->ext[k] = cmax[k] - cmin[k] + 1;
+        if (cells <= ((uint64_t)1 << 40)) cells *= (uint64_t)g->ext[k];
+    }
+    if (cells <= (uint64_t)(4 * n + 1024)) {
+        nbucket = (size_t)cells;
+    } else {
+        hashed = 1;
+        nbucket = 1024;
+        while (nbucket < 2 * n) nbucket *= 2;
+    }
+    if (nbucket + 1 > g->cap_bucket) {
+        size_t cap = nbucket + nbucket / 4 + 16;
+        if (!sph__grow((void**)&g->start, cap, sizeof(uint32_t))) return SPH_ERR_NOMEM;
+        g->cap_bucket = cap;
+    }
+    g->hashed = hashed;
+    g->nbucket = nbucket;
+    g->n = n;
+    SPH__OMP_FOR
+    for (i = 0; i < (sph__idx)n; ++i) {
+        int32_t c[3] = {0, 0, 0};
+        int kk;
+        uint64_t key;
+        for (kk = 0; kk < dim; ++kk)
+            c[kk] = sph__cell_coord(g, kk, x[(size_t)i * (size_t)dim + (size_t)kk]);
+        key = sph__cell_key(c, dim);
+        g->bucket[i] = (uint32_t)sph__cell_bucket(g, c, key);
+    }
+    /* counting sort by bucket, stable in the point index */
+    memset(g->start, 0, (nbucket + 1) * sizeof(uint32_t));
+    for (i = 0; i < (sph__idx)n; ++i) g->start[g->bucket[i] + 1]++;
+    for (b = 0; b < nbucket; ++b) g->start[b + 1] += g->start[b];
+    for (i = 0; i < (sph__idx)n; ++i) g->order[g->start[g->bucket[i]]++] = (uint32_t)i;
+    for (b = nbucket; b > 0; --b) g->start[b] = g->start[b - 1];
+    g->start[0] = 0;
+    /* hash mode: cells of the sorted points, to tell apart cells that share a bucket */
+    if (hashed) {
+        SPH__OMP_FOR
+        for (i = 0; i < (sph__idx)n; ++i) {
+            int32_t c[3] = {0, 0, 0};
+            int kk;
+            const sph_real* xi = x + (size_t)g->order[i] * (size_t)dim;
+            for (kk = 0; kk < dim; ++kk) c[kk] = sph__cell_coord(g, kk, xi[kk]);
+            g->key[i] = sph__cell_key(c, dim);
+        }
+    }
+    return SPH_OK;
+}
+
+/* Calls EMIT(j, d, r2) for every point j of grid g within radius of p (d = p - x_j, r2 = |d|^2).
+   order == NULL: the grid's points are already stored in cell order. Offsets along a periodic
+   direction with two cells are visited once each. */
+#define SPH__GRID_VISIT(g, x, order, p, radius, EMIT)                                              \
+    do {                                                                                           \
+        const int dim_ = (g)->dim;                                                                 \
+        const sph_real r2max_ = (radius) * (radius);                                               \
+        int32_t c0_[3] = {0, 0, 0}, lo_[3] = {0, 0, 0}, hi_[3] = {0, 0, 0};                        \
+        int32_t cc_[3] = {0, 0, 0};                                                                \
+        int k_;                                                                                    \
+        for (k_ = 0; k_ < dim_; ++k_) {                                                            \
+            c0_[k_] = sph__cell_coord((g), k_, (p)[k_]);                                           \
+            if ((g)->periodic[k_] && (g)->ncell[k_] == 2) { lo_[k_] = 0; hi_[k_] = 1; }            \
+            else { lo_[k_] = -1; hi_[k_] = 1; }                                                    \
+        }                                                                                          \
+        for (cc_[2] = lo_[2]; cc_[2] <= hi_[2]; ++cc_[2])                                          \
+        for (cc_[1] = lo_[1]; cc_[1] <= hi_[1]; ++cc_[1])                                          \
+        for (cc_[0] = lo_[0]; cc_[0] <= hi_[0]; ++cc_[0]) {                                        \
+            int32_t c_[3] = {0, 0, 0};                                                             \
+            int ok_ = 1;                                                                           \
+            uint64_t key_;                                                                         \
+            size_t bk_, s_, e_, q_;                                                                \
+            for (k_ = 0; k_ < dim_; ++k_) {                                                        \
+                int32_t v_ = c0_[k_] + cc_[k_];                                                    \
+                if ((g)->periodic[k_]) {                                                           \
+                    if (v_ < 0) v_ += (g)->ncell[k_];                                              \
+                    if (v_ >= (g)->ncell[k_]) v_ -= (g)->ncell[k_];                                \
+                } else if (v_ < -SPH__CELL_LIM || v_ >= SPH__CELL_LIM) ok_ = 0;                    \
+                c_[k_] = v_;                                                                       \
+            }                                                                                      \
+            if (!ok_) continue;                                                                    \
+            key_ = sph__cell_key(c_, dim_);                                                        \
+            bk_ = sph__cell_bucket((g), c_, key_);                                                 \
+            if (bk_ == (size_t)-1) continue;                                                       \
+            s_ = (g)->start[bk_];                                                                  \
+            e_ = (g)->start[bk_ + 1];                                                              \
+            for (q_ = s_; q_ < e_; ++q_) {                                                         \
+                uint32_t j_ = (order) ? (order)[q_] : (uint32_t)q_;                               \
+                const sph_real* xj_ = (x) + (size_t)j_ * (size_t)dim_;                             \
+                sph_real d_[3] = {0, 0, 0}, r2_ = 0;                                               \
+                if ((g)->hashed && (g)->key[q_] != key_) continue;                                 \
+                for (k_ = 0; k_ < dim_; ++k_) {                                                    \
+                    d_[k_] = (p)[k_] - xj_[k_];                                                    \
+                    if ((g)->periodic[k_]) d_[k_] = sph__wrap_delta(d_[k_], (g)->len[k_]);        \
+                    r2_ += d_[k_] * d_[k_];                                                        \
+                }                                                                                  \
+                if (r2_ < r2max_) { EMIT(j_, d_, r2_); }                                           \
+            }                                                                                      \
+        }                                                                                          \
+    } while (0)
+
+SPHDEF size_t sph_grid_query(const sph_grid* g, const sph_real* x, const sph_real* p,
+                             sph_real radius, uint32_t* out, size_t cap) {
+    size_t found = 0;
+#define SPH__EMIT_OUT(j, d, r2)                                                                    \
+    do { (void)(d); (void)(r2); if (found < cap) out[found] = (j); ++found; } while (0)
+    if (!g || !x || !p || g->n == 0) return 0;
+    SPH__GRID_VISIT(g, x, g->order, p, radius, SPH__EMIT_OUT);
+#undef SPH__EMIT_OUT
+    return found;
+}
+
+/* Fills the lists of query points in chunk c; returns the number of entries it needed. */
+static size_t sph__neighbors_chunk(sph_neighbors* nl, const sph_grid* g, const sph_real* x,
+                                   const uint32_t* order, const sph_real* xq, size_t nq,
+                                   sph_real radius, int exclude_self, size_t c) {
+    size_t i, i0 = c * SPH__CHUNK, i1 = i0 + SPH__CHUNK;
+    size_t pos = nl->chunk_off[c], end = pos + nl->chunk_cap[c];
+    const int dim = g->dim;
+    if (i1 > nq) i1 = nq;
+    for (i = i0; i < i1; ++i) {
+        const sph_real* p = xq + i * (size_t)dim;
+        size_t b0 = pos;
+#define SPH__EMIT_LIST(j, d, r2)                                                                   \
+    do {                                                                                           \
+        (void)(d); (void)(r2);                                                                     \
+        if (!(exclude_self && (size_t)(j) == i)) {                                                 \
+            if (pos < end) nl->idx[pos] = (j);                                                     \
+            ++pos;                                                                                 \
+        }                                                                                          \
+    } while (0)
+        SPH__GRID_VISIT(g, x, order, p, radius, SPH__EMIT_LIST);
+#undef SPH__EMIT_LIST
+        nl->begin[i] = b0;
+        nl->count[i] = (uint32_t)(pos - b0);
+    }
+    return pos - nl->chunk_off[c];
+}
+
+static sph_status sph__neighbors_build(sph_neighbors* nl, const sph_grid* g, const sph_real* x,
+                                       const uint32_t* order, const sph_real* xq, size_t nq,
+                                       sph_real radius, int exclude_self) {
+    size_t c, nchunk = (nq + SPH__CHUNK - 1) / SPH__CHUNK, total_cap;
+    int pass;
+    if (nq > nl->cap_n) {
+        size_t cap = nq + nq / 4 + 16;
+        if (!sph__grow((void**)&nl->begin, cap, sizeof(size_t)) ||
+            !sph__grow((void**)&nl->count, cap, sizeof(uint32_t)))
+            return SPH_ERR_NOMEM;
+        nl->cap_n = cap;
+    }
+    if (nchunk > nl->cap_chunk) {
+        size_t cap = nchunk + nchunk / 4 + 4;
+        if (!sph__grow((void**)&nl->chunk_off, cap + 1, sizeof(size_t)) ||
+            !sph__grow((void**)&nl->chunk_need, cap, sizeof(size_t)))
+            return SPH_ERR_NOMEM;
+        if (!sph__grow((void**)&nl->chunk_cap, cap, sizeof(size_t))) return SPH_ERR_NOMEM;
+        for (c = nl->cap_chunk; c < cap; ++c) nl->chunk_cap[c] = 0;
+        nl->cap_chunk = cap;
+    }
+    nl->n = nq;
+    nl->nchunk = nchunk;
+    for (pass = 0; pass < 2; ++pass) {
+        sph__idx ci;
+        int overflow = 0;
+        /* lay the chunk regions out back to back */
+        total_cap = 0;
+        for (c = 0; c < nchunk; ++c) { nl->chunk_off[c] = total_cap; total_cap += nl->chunk_cap[c]; }
+        if (total_cap > nl->cap_idx) {
+            if (!sph__grow((void**)&nl->idx, total_cap, sizeof(uint32_t))) return SPH_ERR_NOMEM;
+            nl->cap_idx = total_cap;
+        }
+        SPH__OMP_FOR_DYNAMIC
+        for (ci = 0; ci < (sph__idx)nchunk; ++ci)
+            nl->chunk_need[ci] = sph__neighbors_chunk(nl, g, x, order, xq, nq, radius,
+                                                      exclude_self, (size_t)ci);
+        for (c = 0; c < nchunk; ++c) {
+            if (nl->chunk_need[c] > nl->chunk_cap[c]) {
+                overflow = 1;
+                nl->chunk_cap[c] = nl->chunk_need[c] + nl->chunk_need[c] / 4 + 16;
+            }
+        }
+        if (!overflow) break;
+        SPH_ASSERT(pass == 0); /* the second pass has room for every chunk */
+    }
+    nl->total = 0;
+    for (c = 0; c < nchunk; ++c) nl->total += nl->chunk_need[c];
+    return SPH_OK;
+}
+
+SPHDEF sph_status sph_neighbors_build(sph_neighbors* nl, const sph_grid* g, const sph_real* x,
+                                      const sph_real* xq, size_t nq, sph_real radius,
+                                      int exclude_self) {
+    if (!nl || !g || (!x && g->n) || (!xq && nq) || !(radius > 0) || radius > g->cell)
+        return SPH_ERR_ARG;
+    return sph__neighbors_build(nl, g, x, g->order, xq, nq, radius, exclude_self);
+}
+
+SPHDEF void sph_neighbors_free(sph_neighbors* nl) {
+    if (!nl) return;
+    SPH_FREE(nl->begin);
+    SPH_FREE(nl->count);
+    SPH_FREE(nl->idx);
+    SPH_FREE(nl->chunk_off);
+    SPH_FREE(nl->chunk_cap);
+    SPH_FREE(nl->chunk_need);
+    memset(nl, 0, sizeof(*nl));
+}
+
+/* ============================================================================================== */
+/* >>world (implementation)                                                                       */
+/* ============================================================================================== */
+
+SPHDEF sph_world_def sph_world_def_default(int dim) {
+    sph_world_def d;
+    memset(&d, 0, sizeof(d));
+    d.dim = dim;
+    d.spacing = SPH__R(0.01);
+    d.h_factor = 0;
+    d.kernel = SPH_KERNEL_WENDLAND_C2;
+    if (dim >= 2) d.gravity[1] = SPH__R(-9.81);
+    d.solver = SPH_SOLVER_WCSPH;
+    d.density = SPH_DENSITY_CONTINUITY;
+    d.pressure_grad = SPH_PGRAD_SYMMETRIC;
+    d.integrator = SPH_INTEGRATOR_SYMPLECTIC_EULER;
+    d.delta = SPH__R(0.1);  /* Molteni & Colagrossi 2009; seed 000 sec. 3.2.1: "usually 0.1" */
+    d.alpha = SPH__R(0.02);
+    d.beta = 0;
+    d.wall = SPH_WALL_FREE_SLIP;
+    d.cfl = SPH__R(0.25);
+    d.cfl_viscous = SPH__R(0.125);
+    d.cfl_force = SPH__R(0.25);
+    d.max_compression = SPH__R(0.2);
+    d.max_speed = 0;
+    return d;
+}
+
+/* Each check names the field and the value it rejects. */
+#define SPH__CHECK(cond, ...)                                                                      \
+    do { if (!(cond)) return sph__fail(w, SPH_ERR_ARG, -1, __VA_ARGS__); } while (0)
+
+static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
+    int k;
+    SPH__CHECK(d->dim >= 1 && d->dim <= 3, "sph_world_def.dim = %d: must be 1, 2 or 3", d->dim);
+    SPH__CHECK(sph__finite((double)d->spacing) && d->spacing > 0,
+               "sph_world_def.spacing = %g: must be finite and > 0", (double)d->spacing);
+    SPH__CHECK(sph__finite((double)d->h_factor) && d->h_factor >= 0 && d->h_factor <= 10,
+               "sph_world_def.h_factor = %g: must be 0 (kernel default) or in (0, 10]",
+               (double)d->h_factor);
+    SPH__CHECK((int)d->kernel >= 0 && d->kernel < SPH_KERNEL_COUNT,
+               "sph_world_def.kernel = %d: not a sph_kernel_type", (int)d->kernel);
+    for (k = 0; k < 3; ++k)
+        SPH__CHECK(sph__finite((double)d->gravity[k]), "sph_world_def.gravity[%d] = %g: not finite",
+                   k, (double)d->gravity[k]);
+    SPH__CHECK(d->solver == SPH_SOLVER_WCSPH, "sph_world_def.solver = %d: not a sph_solver",
+               (int)d->solver);
+    SPH__CHECK((int)d->density >= 0 && d->density <= SPH_DENSITY_PARTICLE,
+               "sph_world_def.density = %d: not a sph_density", (int)d->density);
+    SPH__CHECK((int)d->pressure_grad >= 0 && d->pressure_grad <= SPH_PGRAD_MULTIPHASE,
+               "sph_world_def.pressure_grad = %d: not a sph_pressure_grad", (int)d->pressure_grad);
+    SPH__CHECK((int)d->integrator >= 0 && d->integrator <= SPH_INTEGRATOR_VERLET,
+               "sph_world_def.integrator = %d: not a sph_integrator", (int)d->integrator);
+    SPH__CHECK((int)d->clamp >= 0 && d->clamp <= SPH_CLAMP_OFF,
+               "sph_world_def.clamp = %d: not a sph_pressure_clamp", (int)d->clamp);
+    SPH__CHECK((int)d->wall >= 0 && d->wall <= SPH_WALL_NO_SLIP,
+               "sph_world_def.wall = %d: not a sph_wall", (int)d->wall);
+    SPH__CHECK(sph__finite((double)d->delta) && d->delta >= 0 && d->delta <= 1,
+               "sph_world_def.delta = %g: must be in [0, 1]", (double)d->delta);
+    SPH__CHECK(sph__finite((double)d->alpha) && d->alpha >= 0 && d->alpha <= 10,
+               "sph_world_def.alpha = %g: must be in [0, 10]", (double)d->alpha);
+    SPH__CHECK(sph__finite((double)d->beta) && d->beta >= 0 && d->beta <= 10,
+               "sph_world_def.beta = %g: must be in [0, 10]", (double)d->beta);
+    SPH__CHECK(sph__finite((double)d->cfl) && d->cfl > 0 && d->cfl <= 1,
+               "sph_world_def.cfl = %g: must be in (0, 1]", (double)d->cfl);
+    SPH__CHECK(sph__finite((double)d->cfl_viscous) && d->cfl_viscous > 0 && d->cfl_viscous <= 1,
+               "sph_world_def.cfl_viscous = %g: must be in (0, 1]", (double)d->cfl_viscous);
+    SPH__CHECK(sph__finite((double)d->cfl_force) && d->cfl_force > 0 && d->cfl_force <= 1,
+               "sph_world_def.cfl_force = %g: must be in (0, 1]", (double)d->cfl_force);
+    SPH__CHECK(sph__finite((double)d->max_compression) && d->max_compression >= 0,
+               "sph_world_def.max_compression = %g: must be finite and >= 0",
+               (double)d->max_compression);
+    SPH__CHECK(sph__finite((double)d->max_speed) && d->max_speed >= 0,
+               "sph_world_def.max_speed = %g: must be finite and >= 0", (double)d->max_speed);
+    for (k = 0; k < d->dim; ++k) {
+        SPH__CHECK(sph__finite((double)d->domain_lo[k]) && sph__finite((double)d->domain_hi[k]) &&
+                       d->domain_lo[k] <= d->domain_hi[k],
+                   "sph_world_def.domain_lo/hi[%d] = %g/%g: must be finite with lo <= hi", k,
+                   (double)d->domain_lo[k], (double)d->domain_hi[k]);
+    }
+    return SPH_OK;
+}
+
+SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
+    sph_status s;
+    sph_real hf, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    int k, per[3] = {0, 0, 0};
+    if (!w) return SPH_ERR_ARG;
+    memset(w, 0, sizeof(*w));
+    w->error_index = -1;
+    if (!def) return sph__fail(w, SPH_ERR_ARG, -1, "sph_world_init: def is NULL");
+    s = sph__validate_def(w, def);
+    if (s != SPH_OK) return s;
+    w->def = *def;
+    for (k = def->dim; k < 3; ++k) {
+        w->def.gravity[k] = 0;
+        w->def.periodic[k] = 0;
+        w->def.domain_lo[k] = w->def.domain_hi[k] = 0;
+    }
+    w->dim = def->dim;
+    w->dx = def->spacing;
+    hf = def->h_factor > 0 ? def->h_factor : sph_kernel_default_h_factor(def->kernel);
+    w->def.h_factor = hf;
+    w->h = hf * def->spacing;
+    s = sph_kernel_init(&w->kernel, def->kernel, def->dim, w->h);
+    if (s != SPH_OK) return sph__fail(w, s, -1, "sph_world_init: kernel setup failed");
+    for (k = 0; k < def->dim; ++k) {
+        per[k] = def->periodic[k] != 0;
+        lo[k] = def->domain_lo[k];
+        hi[k] = def->domain_hi[k];
+        if (per[k] && !(hi[k] - lo[k] >= 2 * w->kernel.radius))
+            return sph__fail(w, SPH_ERR_ARG, -1,
+                             "sph_world_def.periodic[%d]: domain length %g must be at least two "
+                             "kernel support radii (%g)",
+                             k, (double)(hi[k] - lo[k]), (double)(2 * w->kernel.radius));
+    }
+    s = sph_grid_init(&w->priv.grid, def->dim, w->kernel.radius, per, lo, hi);
+    if (s == SPH_OK) s = sph_grid_init(&w->priv.bgrid, def->dim, w->kernel.radius, per, lo, hi);
+    if (s != SPH_OK) return sph__fail(w, s, -1, "sph_world_init: grid setup failed");
+    w->status = SPH_OK;
+    return SPH_OK;
+}
+
+SPHDEF void sph_world_free(sph_world* w) {
+    if (!w) return;
+    SPH_FREE(w->x); SPH_FREE(w->v); SPH_FREE(w->rho); SPH_FREE(w->p); SPH_FREE(w->m);
+    SPH_FREE(w->id); SPH_FREE(w->phase); SPH_FREE(w->a); SPH_FREE(w->drho);
+    SPH_FREE(w->b_x); SPH_FREE(w->b_v); SPH_FREE(w->b_a); SPH_FREE(w->b_x0); SPH_FREE(w->b_vol);
+    SPH_FREE(w->b_p); SPH_FREE(w->b_rho); SPH_FREE(w->b_vw); SPH_FREE(w->b_id);
+    SPH_FREE(w->b_body);
+    sph_grid_free(&w->priv.grid);
+    sph_grid_free(&w->priv.bgrid);
+    sph_neighbors_free(&w->priv.ff);
+    sph_neighbors_free(&w->priv.fb);
+    sph_neighbors_free(&w->priv.bf);
+    SPH_FREE(w->priv.perm_buf);
+    SPH_FREE(w->priv.b_order);
+    SPH_FREE(w->priv.block);
+    SPH_FREE(w->priv.rho_n);
+    memset(w, 0, sizeof(*w));
+    w->error_index = -1;
+}
+
+SPHDEF const char* sph_world_error(const sph_world* w) { return w ? w->error : ""; }
+
+/* The per-particle arrays, listed once so that growing and reordering cannot forget one.
+   persistent arrays carry state from step to step and follow the particles when they are sorted;
+   the others are recomputed inside every step. */
+typedef struct sph__array {
+    void** ptr;
+    size_t elem;
+    int persistent;
+} sph__array;
+
+static int sph__fluid_arrays(sph_world* w, sph__array* a) {
+    const size_t vec = (size_t)w->dim * sizeof(sph_real), r = sizeof(sph_real);
+    int n = 0;
+    a[n].ptr = (void**)&w->x; a[n].elem = vec; a[n++].persistent = 1;
+    a[n].ptr = (void**)&w->v; a[n].elem = vec; a[n++].persistent = 1;
+    a[n].ptr = (void**)&w->rho; a[n].elem = r; a[n++].persistent = 1;
+    a[n].ptr = (void**)&w->p; a[n].elem = r; a[n++].persistent = 1;
+    a[n].ptr = (void**)&w->id; a[n].elem = sizeof(uint32_t); a[n++].persistent = 1;
+    a[n].ptr = (void**)&w->phase; a[n].elem = sizeof(uint8_t); a[n++].persistent = 1;
+    a[n].ptr = (void**)&w->drho; a[n].elem = r; a[n++].persistent = 1; /* Verlet keeps it */
+    a[n].ptr = (void**)&w->a; a[n].elem = vec; a[n++].persistent = 0;
+    if (w->m) { a[n].ptr = (void**)&w->m; a[n].elem = r; a[n++].persistent = 1; }
+    return n;
+}
+
+static int sph__boundary_arrays(sph_world* w, sph__array* a) {
+    const size_t vec = (size_t)w->dim * sizeof(sph_real), r = sizeof(sph_real);
+    int n = 0;
+    a[n].ptr = (void**)&w->b_x; a[n].elem = vec; a[n++].persistent = 1;
+    a[n].ptr = (void**)&w->b_v; a[n].elem = vec; a[n++].persistent = 1;
+    a[n].ptr = (void**)&w->b_a; a[n].elem = vec; a[n++].persistent = 1;
+    a[n].ptr = (void**)&w->b_x0; a[n].elem = vec; a[n++].persistent = 1;
+    a[n].ptr = (void**)&w->b_vol; a[n].elem = r; a[n++].persistent = 1;
+    a[n].ptr = (void**)&w->b_id; a[n].elem = sizeof(uint32_t); a[n++].persistent = 1;
+    a[n].ptr = (void**)&w->b_body; a[n].elem = sizeof(uint16_t); a[n++].persistent = 1;
+    a[n].ptr = (void**)&w->b_p; a[n].elem = r; a[n++].persistent = 0;
+    a[n].ptr = (void**)&w->b_rho; a[n].elem = r; a[n++].persistent = 0;
+    a[n].ptr = (void**)&w->b_vw; a[n].elem = vec; a[n++].persistent = 0;
+    return n;
+}
+
+/* Room for `need` particles in every array of the set; the permutation buffer grows with it. */
+static sph_status sph__reserve(sph_world* w, int boundary, size_t need) {
+    sph__array arr[16];
+    size_t* cap = boundary ? &w->b_capacity : &w->capacity;
+    size_t newcap, bytes;
+    int n, k;
+    if (need <= *cap) return SPH_OK;
+    if (need > (size_t)UINT32_MAX - 1)
+        return sph__fail(w, SPH_ERR_CAPACITY, -1, "%zu particles exceed the limit of %u", need,
+                         (unsigned)(UINT32_MAX - 1));
+    newcap = *cap + *cap / 2 + 64;
+    if (newcap < need) newcap = need;
+    n = boundary ? sph__boundary_arrays(w, arr) : sph__fluid_arrays(w, arr);
+    /* each array grows on its own: after a failure the grown ones are merely larger than needed */
+    for (k = 0; k < n; ++k)
+        if (!sph__grow(arr[k].ptr, newcap, arr[k].elem))
+            return sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory growing to %zu particles", newcap);
+    bytes = newcap * (size_t)w->dim * sizeof(sph_real);
+    if (bytes > w->priv.perm_cap) {
+        if (!sph__grow((void**)&w->priv.perm_buf, bytes, 1))
+            return sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory growing to %zu particles", newcap);
+        w->priv.perm_cap = bytes;
+    }
+    *cap = newcap;
+    return SPH_OK;
+}
+
+static int sph__check_phase(sph_world* w, int phase) {
+    if (phase < 0 || phase >= w->nphase) {
+        sph__fail(w, SPH_ERR_ARG, -1, "phase %d does not exist (the world has %d phases)", phase,
+                  w->nphase);
+        return 0;
+    }
+    return 1;
+}
+
+SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase) {
+    sph_phase ph;
+    double vol;
+    if (!w) return -1;
+    if (!phase) { sph__fail(w, SPH_ERR_ARG, -1, "sph_world_add_phase: phase is NULL"); return -1; }
+    if (w->nphase >= SPH_MAX_PHASES) {
+        sph__fail(w, SPH_ERR_CAPACITY, -1, "a world holds at most %d phases", SPH_MAX_PHASES);
+        return -1;
+    }
+    ph = *phase;
+#define SPH__PCHECK(cond, ...)                                                                     \
+    do { if (!(cond)) { sph__fail(w, SPH_ERR_ARG, -1, __VA_ARGS__); return -1; } } while (0)
+    SPH__PCHECK(sph__finite((double)ph.rest_density) && ph.rest_density > 0,
+                "sph_phase.rest_density = %g: must be finite and > 0", (double)ph.rest_density);
+    SPH__PCHECK(sph__finite((double)ph.viscosity) && ph.viscosity >= 0,
+                "sph_phase.viscosity = %g: must be finite and >= 0", (double)ph.viscosity);
+    SPH__PCHECK(sph__finite((double)ph.sound_speed) && ph.sound_speed >= 0,
+                "sph_phase.sound_speed = %g: must be finite and >= 0 (0 = automatic)",
+                (double)ph.sound_speed);
+    SPH__PCHECK((int)ph.eos >= 0 && ph.eos <= SPH_EOS_LINEAR, "sph_phase.eos = %d: not a sph_eos",
+                (int)ph.eos);
+    SPH__PCHECK(sph__finite((double)ph.gamma) && (ph.gamma == 0 || (ph.gamma >= 1 && ph.gamma <= 20)),
+                "sph_phase.gamma = %g: must be 0 (= 7) or in [1, 20]", (double)ph.gamma);
+    SPH__PCHECK(sph__finite((double)ph.back_pressure), "sph_phase.back_pressure = %g: not finite",
+                (double)ph.back_pressure);
+    SPH__PCHECK(sph__finite((double)ph.mass) && ph.mass >= 0,
+                "sph_phase.mass = %g: must be finite and >= 0 (0 = rest_density * dx^dim)",
+                (double)ph.mass);
+#undef SPH__PCHECK
+    if (ph.gamma == 0) ph.gamma = 7;
+    vol = (double)w->dx;
+    if (w->dim >= 2) vol *= (double)w->dx;
+    if (w->dim >= 3) vol *= (double)w->dx;
+    if (ph.mass == 0) ph.mass = (sph_real)((double)ph.rest_density * vol);
+    w->phases[w->nphase] = ph;
+    return w->nphase++;
+}
+
+/* Appends n fluid particles of one phase and mass; x, v (NULL = 0) are validated by the caller. */
+static sph_status sph__append_fluid(sph_world* w, int phase, size_t n, const sph_real* x,
+                                    const sph_real* v, sph_real mass) {
+    const size_t dim = (size_t)w->dim;
+    size_t i, base = w->n;
+    sph_status s;
+    int need_m = w->m == NULL && w->priv.have_mass && mass != w->priv.mass;
+    s = sph__reserve(w, 0, w->n + n);
+    if (s != SPH_OK) return s;
+    if (need_m) { /* particles of different masses: keep a mass per particle from now on */
+        sph_real* m = NULL;
+        if (!sph__grow((void**)&m, w->capacity, sizeof(sph_real)))
+            return sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory for the mass array");
+        for (i = 0; i < w->n; ++i) m[i] = w->priv.mass;
+        w->m = m;
+    }
+    for (i = 0; i < n; ++i) {
+        size_t j = base + i, k;
+        for (k = 0; k < dim; ++k) {
+            w->x[j * dim + k] = x[i * dim + k];
+            w->v[j * dim + k] = v ? v[i * dim + k] : 0;
+            w->a[j * dim + k] = 0;
+        }
+        w->rho[j] = w->phases[phase].rest_density;
+        w->p[j] = 0;
+        w->drho[j] = 0;
+        w->id[j] = w->next_id++;
+        w->phase[j] = (uint8_t)phase;
+        if (w->m) w->m[j] = mass;
+    }
+    if (!w->priv.have_mass) { w->priv.have_mass = 1; w->priv.mass = mass; }
+    w->n += n;
+    return SPH_OK;
+}
+
+static int sph__all_finite(const sph_real* a, size_t count, size_t* bad) {
+    size_t i;
+    for (i = 0; i < count; ++i)
+        if (!sph__finite((double)a[i])) { *bad = i; return 0; }
+    return 1;
+}
+
+SPHDEF sph_status sph_add_fluid(sph_world* w, int phase, size_t n, const sph_real* x,
+                                const sph_real* v) {
+    size_t bad = 0, dim;
+    if (!w) return SPH_ERR_ARG;
+    if (!sph__check_phase(w, phase)) return SPH_ERR_ARG;
+    if (n == 0) return SPH_OK;
+    if (!x) return sph__fail(w, SPH_ERR_ARG, -1, "sph_add_fluid: x is NULL");
+    dim = (size_t)w->dim;
+    if (!sph__all_finite(x, n * dim, &bad))
+        return sph__fail(w, SPH_ERR_ARG, (long)(bad / dim),
+                         "sph_add_fluid: x of particle %zu is not finite (%g)", bad / dim,
+                         (double)x[bad]);
+    if (v && !sph__all_finite(v, n * dim, &bad))
+        return sph__fail(w, SPH_ERR_ARG, (long)(bad / dim),
+                         "sph_add_fluid: v of particle %zu is not finite (%g)", bad / dim,
+                         (double)v[bad]);
+    return sph__append_fluid(w, phase, n, x, v, w->phases[phase].mass);
+}
+
+static sph_status sph__check_box(sph_world* w, const char* fn, const sph_real* lo,
+                                 const sph_real* hi) {
+    int k;
+    if (!lo || !hi) return sph__fail(w, SPH_ERR_ARG, -1, "%s: lo or hi is NULL", fn);
+    for (k = 0; k < w->dim; ++k)
+        if (!sph__finite((double)lo[k]) || !sph__finite((double)hi[k]) || !(hi[k] > lo[k]))
+            return sph__fail(w, SPH_ERR_ARG, -1,
+                             "%s: box [%g, %g] in direction %d must be finite with lo < hi", fn,
+                             (double)lo[k], (double)hi[k], k);
+    return SPH_OK;
+}
+
+SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, const sph_real* hi) {
+    const int dim = w ? w->dim : 0;
+    size_t cnt[3] = {1, 1, 1}, total = 1, i;
+    sph_real* pts;
+    sph_status s;
+    int k;
+    if (!w) return SPH_ERR_ARG;
+    if (!sph__check_phase(w, phase)) return SPH_ERR_ARG;
+    s = sph__check_box(w, "sph_fill_box", lo, hi);
+    if (s != SPH_OK) return s;
+    for (k = 0; k < dim; ++k) {
+        double c = floor((double)((hi[k] - lo[k]) / w->dx) + 1e-6);
+        if (c < 1)
+            return sph__fail(w, SPH_ERR_ARG, -1,
+                             "sph_fill_box: box is thinner than one spacing in direction %d", k);
+        if (c > 1e7) return sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_fill_box: box too large");
+        cnt[k] = (size_t)c;
+        total *= cnt[k];
+    }
+    if (total + w->n > (size_t)UINT32_MAX - 1)
+        return sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_fill_box: too many particles");
+    pts = (sph_real*)SPH_MALLOC(total * (size_t)dim * sizeof(sph_real));
+    if (!pts) return sph__fail(w, SPH_ERR_NOMEM, -1, "sph_fill_box: out of memory");
+    for (i = 0; i < total; ++i) { /* x fastest, as the cell sort would order them */
+        size_t r = i;
+        for (k = 0; k < dim; ++k) {
+            pts[i * (size_t)dim + (size_t)k] = lo[k] + ((sph_real)(r % cnt[k]) + SPH__R(0.5)) * w->dx;
+            r /= cnt[k];
+        }
+    }
+    s = sph__append_fluid(w, phase, total, pts, NULL, w->phases[phase].mass);
+    SPH_FREE(pts);
+    return s;
+}
+
+static sph_status sph__append_boundary(sph_world* w, size_t n, const sph_real* x,
+                                       const sph_real* vol, int body) {
+    const size_t dim = (size_t)w->dim;
+    size_t i, k, base = w->nb;
+    sph_status s = sph__reserve(w, 1, w->nb + n);
+    if (s != SPH_OK) return s;
+    for (i = 0; i < n; ++i) {
+        size_t j = base + i;
+        for (k = 0; k < dim; ++k) {
+            w->b_x[j * dim + k] = x[i * dim + k];
+            w->b_x0[j * dim + k] = x[i * dim + k];
+            w->b_v[j * dim + k] = 0;
+            w->b_a[j * dim + k] = 0;
+            w->b_vw[j * dim + k] = 0;
+        }
+        w->b_vol[j] = vol[i];
+        w->b_p[j] = 0;
+        w->b_rho[j] = 1;
+        w->b_id[j] = w->b_next_id++;
+        w->b_body[j] = (uint16_t)body;
+    }
+    w->nb += n;
+    w->priv.b_dirty = 1;
+    return SPH_OK;
+}
+
+SPHDEF sph_status sph_add_boundary(sph_world* w, size_t n, const sph_real* x, const sph_real* vol,
+                                   int body) {
+    size_t bad = 0, i, dim;
+    sph_real* v0 = NULL;
+    sph_status s;
+    if (!w) return SPH_ERR_ARG;
+    if (n == 0) return SPH_OK;
+    dim = (size_t)w->dim;
+    if (!x) return sph__fail(w, SPH_ERR_ARG, -1, "sph_add_boundary: x is NULL");
+    if (body < 0 || body > 65535)
+        return sph__fail(w, SPH_ERR_ARG, -1, "sph_add_boundary: body = %d: must be in [0, 65535]",
+                         body);
+    if (!sph__all_finite(x, n * dim, &bad))
+        return sph__fail(w, SPH_ERR_ARG, (long)(bad / dim),
+                         "sph_add_boundary: x of particle %zu is not finite (%g)", bad / dim,
+                         (double)x[bad]);
+    if (vol) {
+        for (i = 0; i < n; ++i)
+            if (!sph__finite((double)vol[i]) || !(vol[i] > 0))
+                return sph__fail(w, SPH_ERR_ARG, (long)i,
+                                 "sph_add_boundary: vol of particle %zu = %g: must be finite and > 0",
+                                 i, (double)vol[i]);
+        return sph__append_boundary(w, n, x, vol, body);
+    }
+    v0 = (sph_real*)SPH_MALLOC(n * sizeof(sph_real));
+    if (!v0) return sph__fail(w, SPH_ERR_NOMEM, -1, "sph_add_boundary: out of memory");
+    for (i = 0; i < n; ++i)
+        v0[i] = w->dim == 1 ? w->dx : w->dim == 2 ? w->dx * w->dx : w->dx * w->dx * w->dx;
+    s = sph__append_boundary(w, n, x, v0, body);
+    SPH_FREE(v0);
+    return s;
+}
+
+SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_real* hi,
+                                   int layers, unsigned open_faces) {
+    /* Per direction: `layers` wall coordinates below lo, the interior at a spacing that divides
+       hi - lo exactly (closest to dx), `layers` above hi. A point is a wall point if it lies
+       outside the box in some direction, unless it lies beyond an open face. */
+    const int dim = w ? w->dim : 0;
+    sph_real* coord[3] = {NULL, NULL, NULL};
+    sph_real* width[3] = {NULL, NULL, NULL};
+    int* side[3] = {NULL, NULL, NULL};
+    size_t cnt[3] = {1, 1, 1}, total = 1, i, nw = 0;
+    sph_real *pts = NULL, *vol = NULL;
+    sph_status s;
+    int k;
+    if (!w) return SPH_ERR_ARG;
+    s = sph__check_box(w, "sph_add_wall_box", lo, hi);
+    if (s != SPH_OK) return s;
+    if (layers < 0 || layers > 64)
+        return sph__fail(w, SPH_ERR_ARG, -1, "sph_add_wall_box: layers = %d: must be in [0, 64]",
+                         layers);
+    if (open_faces > 63u)
+        return sph__fail(w, SPH_ERR_ARG, -1, "sph_add_wall_box: open_faces = %u: not SPH_FACE_* bits",
+                         open_faces);
+    if (layers == 0) layers = (int)ceil((double)(w->kernel.radius / w->dx) - 1e-9);
+    for (k = 0; k < dim; ++k) {
+        double span = (double)((hi[k] - lo[k]) / w->dx);
+        size_t ni = (size_t)(span + 0.5), j, c = 0;
+        sph_real sp;
+        if (ni < 1) ni = 1;
+        if (span > 1e7) return sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_add_wall_box: box too large");
+        sp = (hi[k] - lo[k]) / (sph_real)ni;
+        cnt[k] = ni + 2 * (size_t)layers;
+        coord[k] = (sph_real*)SPH_MALLOC(cnt[k] * sizeof(sph_real));
+        width[k] = (sph_real*)SPH_MALLOC(cnt[k] * sizeof(sph_real));
+        side[k] = (int*)SPH_MALLOC(cnt[k] * sizeof(int));
+        if (!coord[k] || !width[k] || !side[k]) { s = SPH_ERR_NOMEM; goto done; }
+        for (j = (size_t)layers; j > 0; --j, ++c) {
+            coord[k][c] = lo[k] - ((sph_real)(j - 1) + SPH__R(0.5)) * w->dx;
+            width[k][c] = w->dx;
+            side[k][c] = -1;
+        }
+        for (j = 0; j < ni; ++j, ++c) {
+            coord[k][c] = lo[k] + ((sph_real)j + SPH__R(0.5)) * sp;
+            width[k][c] = sp;
+            side[k][c] = 0;
+        }
+        for (j = 0; j < (size_t)layers; ++j, ++c) {
+            coord[k][c] = hi[k] + ((sph_real)j + SPH__R(0.5)) * w->dx;
+            width[k][c] = w->dx;
+            side[k][c] = 1;
+        }
+        total *= cnt[k];
+    }
+    pts = (sph_real*)SPH_MALLOC(total * (size_t)dim * sizeof(sph_real));
+    vol = (sph_real*)SPH_MALLOC(total * sizeof(sph_real));
+    if (!pts || !vol) { s = SPH_ERR_NOMEM; goto done; }
+    for (i = 0; i < total; ++i) {
+        size_t r = i, ix[3] = {0, 0, 0};
+        int outside = 0, open = 0;
+        sph_real V = 1;
+        for (k = 0; k < dim; ++k) { ix[k] = r % cnt[k]; r /= cnt[k]; }
+        for (k = 0; k < dim; ++k) {
+            int sd = side[k][ix[k]];
+            if (sd != 0) outside = 1;
+            if (sd < 0 && (open_faces & (1u << (2 * k)))) open = 1;
+            if (sd > 0 && (open_faces & (1u << (2 * k + 1)))) open = 1;
+            V *= width[k][ix[k]];
+        }
+        if (!outside || open) continue;
+        for (k = 0; k < dim; ++k) pts[nw * (size_t)dim + (size_t)k] = coord[k][ix[k]];
+        vol[nw++] = V;
+    }
+    s = sph__append_boundary(w, nw, pts, vol, 0);
+done:
+    if (s == SPH_ERR_NOMEM) sph__fail(w, s, -1, "sph_add_wall_box: out of memory");
+    for (k = 0; k < 3; ++k) { SPH_FREE(coord[k]); SPH_FREE(width[k]); SPH_FREE(side[k]); }
+    SPH_FREE(pts);
+    SPH_FREE(vol);
+    return s;
+}
+
+SPHDEF double sph_world_mass(const sph_world* w) {
+    double sum = 0;
+    size_t i;
+    if (!w) return 0;
+    for (i = 0; i < w->n; ++i) sum += (double)(w->m ? w->m[i] : w->priv.mass);
+    return sum;
+}
+
+SPHDEF void sph_world_momentum(const sph_world* w, double* out) {
+    size_t i;
+    int k;
+    if (!w || !out) return;
+    for (k = 0; k < w->dim; ++k) out[k] = 0;
+    for (i = 0; i < w->n; ++i) {
+        double mi = (double)(w->m ? w->m[i] : w->priv.mass);
+        for (k = 0; k < w->dim; ++k) out[k] += mi * (double)w->v[i * (size_t)w->dim + (size_t)k];
+    }
+}
+
+/* ============================================================================================== */
+/* >>boundaries (implementation)                                                                  */
+/* ============================================================================================== */
+/* Boundary particles stand in for the wall as a layer of "fluid" seen by each fluid particle i:
+   a wall particle b of volume V_b acts on i like a particle of mass psi_ib = rho0_i V_b (Akinci et
+   al. 2012 write the same psi for the density sum), pressure p_b and density rho0_i * b_rho[b].
+   Taking the rest density of the fluid particle's own phase keeps walls neutral in multiphase
+   flows; for one phase and lattice walls (V_b = dx^d) it is Adami et al.'s dummy particle. */
+
+/* Tait or linear equation of state per phase, with the constants prepared once per step. */
+typedef struct sph__phase_c {
+    sph_real rho0, inv_rho0, c0, B, inv_B, gamma, inv_gamma, pb, mu;
+    int eos, gamma7;
+} sph__phase_c;
+
+SPH__INLINE sph_real sph__eos(const sph__phase_c* P, sph_real rho) {
+    sph_real t = rho * P->inv_rho0;
+    if (P->eos == SPH_EOS_LINEAR) return P->c0 * P->c0 * (rho - P->rho0) + P->pb;
+    if (P->gamma7) { /* gamma = 7 without pow */
+        sph_real t2 = t * t, t4 = t2 * t2;
+        return P->B * (t4 * t2 * t - 1) + P->pb;
+    }
+    return P->B * (sph__pow(t, P->gamma) - 1) + P->pb;
+}
+
+/* rho/rho0 for pressure p: the inverse of sph__eos. Tension beyond what the fluid can carry is
+   clamped at rho/rho0 = 0.01 (the wall would otherwise get a non-positive density). */
+SPH__INLINE sph_real sph__eos_inverse(const sph__phase_c* P, sph_real p) {
+    sph_real t;
+    if (P->eos == SPH_EOS_LINEAR) {
+        t = 1 + (p - P->pb) * P->inv_rho0 / (P->c0 * P->c0);
+        return t > SPH__R(0.01) ? t : SPH__R(0.01);
+    }
+    t = (p - P->pb) * P->inv_B + 1;
+    if (t < SPH__R(1e-14)) t = SPH__R(1e-14);
+    t = sph__pow(t, P->inv_gamma);
+    return t > SPH__R(0.01) ? t : SPH__R(0.01);
+}
+
+/* Everything a neighbour loop reads, gathered once per stage. */
+typedef struct sph__ctx {
+    int dim, periodic_any, per[3], has_b, nphase;
+    sph_real len[3];
+    sph_kernel k;
+    sph_real h, eta2;          /* eta^2 = 0.01 h^2 regularises 1/r^2 (Monaghan 1992)            */
+    const sph_real *x, *v, *rho, *p, *m;
+    sph_real m0;
+    const uint8_t* ph;
+    const sph_real *bx, *bv, *bvw, *bvol, *bp, *brho;
+    sph__phase_c pc[SPH_MAX_PHASES];
+    const sph_neighbors *ff, *fb, *bf;
+    int density, pgrad, noslip, laminar, av, delta_on;
+    sph_real alpha, beta, delta, visc_k;
+    sph_real g[3];
+} sph__ctx;
+
+static void sph__ctx_init(sph_world* w, sph__ctx* c) {
+    int k, q;
+    memset(c, 0, sizeof(*c));
+    c->dim = w->dim;
+    for (k = 0; k < w->dim; ++k) {
+        c->per[k] = w->def.periodic[k] != 0;
+        c->len[k] = w->def.domain_hi[k] - w->def.domain_lo[k];
+        if (c->per[k]) c->periodic_any = 1;
+        c->g[k] = w->def.gravity[k];
+    }
+    c->has_b = w->nb > 0;
+    c->k = w->kernel;
+    c->h = w->h;
+    c->eta2 = SPH__R(0.01) * w->h * w->h;
+    c->x = w->x; c->v = w->v; c->rho = w->rho; c->p = w->p; c->m = w->m;
+    c->m0 = w->priv.mass;
+    c->ph = w->phase;
+    c->bx = w->b_x; c->bv = w->b_v; c->bvw = w->b_vw; c->bvol = w->b_vol;
+    c->bp = w->b_p; c->brho = w->b_rho;
+    c->ff = &w->priv.ff; c->fb = &w->priv.fb; c->bf = &w->priv.bf;
+    c->nphase = w->nphase;
+    c->laminar = 0;
+    for (q = 0; q < w->nphase; ++q) {
+        const sph_phase* P = &w->phases[q];
+        sph__phase_c* C = &c->pc[q];
+        C->rho0 = P->rest_density;
+        C->inv_rho0 = 1 / P->rest_density;
+        C->c0 = P->sound_speed;
+        C->gamma = P->gamma;
+        C->inv_gamma = 1 / P->gamma;
+        C->gamma7 = P->gamma == 7;
+        C->B = P->rest_density * P->sound_speed * P->sound_speed / P->gamma;
+        C->inv_B = C->B > 0 ? 1 / C->B : 0;
+        C->pb = P->back_pressure;
+        C->eos = (int)P->eos;
+        C->mu = P->rest_density * P->viscosity; /* dynamic viscosity [Pa s] */
+        if (P->viscosity > 0) c->laminar = 1;
+    }
+    c->density = (int)w->def.density;
+    c->pgrad = (int)w->def.pressure_grad;
+    c->noslip = w->def.wall == SPH_WALL_NO_SLIP;
+    c->alpha = w->def.alpha;
+    c->beta = w->def.beta;
+    c->av = w->def.alpha > 0 || w->def.beta > 0;
+    c->delta = w->def.delta;
+    c->delta_on = w->def.delta > 0;
+    /* Monaghan 2005 / seed 000 sec. 2.2.2: nu Lap v = 2(d+2) sum_j m_j nu_bar/rho_bar ...; with
+       (mu_i + mu_j)/(rho_i rho_j) the factor 2 of the average moves into visc_k = d + 2. */
+    c->visc_k = (sph_real)(w->dim + 2);
+}
+
+SPH__INLINE void sph__delta_vec(const sph__ctx* c, const sph_real* a, const sph_real* b,
+                                sph_real* d, const int D) {
+    int k;
+    for (k = 0; k < D; ++k) {
+        d[k] = a[k] - b[k];
+        if (c->periodic_any && c->per[k]) d[k] = sph__wrap_delta(d[k], c->len[k]);
+    }
+}
+
+/* Adami, Hu & Adams 2012, eq. 27: the pressure of wall particle b extrapolated from its fluid
+   neighbours f, with the wall's acceleration a_b (moving walls):
+       p_b = (sum_f p_f W_bf + (g - a_b) . sum_f rho_f x_bf W_bf) / sum_f W_bf,  x_bf = x_b - x_f.
+   The wall density follows from each neighbouring phase's equation of state (Adami eq. 28),
+   stored relative to rest as b_rho[b] = sum_f W_bf (rho/rho0)_f(p_b) / sum_f W_bf.
+   No-slip (Adami eqs. 22-23): the viscous terms see v~_b = 2 v_b - sum_f v_f W_bf / sum_f W_bf. */
+static void sph__stage_wall_pressure(sph_world* w, const sph__ctx* c) {
+    const int D = c->dim;
+    sph__idx b;
+    SPH__OMP_FOR
+    for (b = 0; b < (sph__idx)w->nb; ++b) {
+        const sph_neighbors* nl = c->bf;
+        const sph_real* xb = c->bx + (size_t)b * (size_t)D;
+        sph_real sw = 0, swp = 0, srx[3] = {0, 0, 0}, sv[3] = {0, 0, 0}, wph[SPH_MAX_PHASES];
+        size_t kk, k0 = nl->begin[b], k1 = k0 + nl->count[b];
+        int k, q;
+        for (q = 0; q < c->nphase; ++q) wph[q] = 0;
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t f = nl->idx[kk];
+            sph_real d[3] = {0, 0, 0}, r2 = 0, W;
+            sph__delta_vec(c, xb, c->x + f * (size_t)D, d, D);
+            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+            W = sph__kw(c->k.form, sph__sqrt(r2) * c->k.inv_h);
+            sw += W;
+            swp += c->p[f] * W;
+            for (k = 0; k < D; ++k) {
+                srx[k] += c->rho[f] * d[k] * W;
+                sv[k] += c->v[f * (size_t)D + (size_t)k] * W;
+            }
+            wph[c->ph[f]] += W;
+        }
+        if (sw > 0) {
+            sph_real pb = swp, kap = 0;
+            for (k = 0; k < D; ++k) pb += (c->g[k] - w->b_a[(size_t)b * (size_t)D + (size_t)k]) * srx[k];
+            pb /= sw;
+            for (q = 0; q < c->nphase; ++q)
+                if (wph[q] > 0) kap += wph[q] * sph__eos_inverse(&c->pc[q], pb);
+            w->b_p[b] = pb;
+            w->b_rho[b] = kap / sw;
+            for (k = 0; k < D; ++k)
+                w->b_vw[(size_t)b * (size_t)D + (size_t)k] =
+                    2 * c->bv[(size_t)b * (size_t)D + (size_t)k] - sv[k] / sw;
+        } else {
+            w->b_p[b] = 0;
+            w->b_rho[b] = 1;
+            for (k = 0; k < D; ++k)
+                w->b_vw[(size_t)b * (size_t)D + (size_t)k] = c->bv[(size_t)b * (size_t)D + (size_t)k];
+        }
+    }
+}
+
+/* ============================================================================================== */
+/* >>stages (implementation)                                                                      */
+/* ============================================================================================== */
+
+static void sph__time(sph_world* w, sph_stage s, double* t0) {
+    double t = sph__now();
+    w->stats.stage_time[s] += t - *t0;
+    *t0 = t;
+}
+
+/* Sound speeds left at 0 are chosen once, when the phase first has particles: c0 = 10 U with
+   U = max(sqrt(2 |g| H), |v|max), so the density varies by about 1 % (Monaghan 1994). */
+static sph_status sph__resolve_sound_speed(sph_world* w) {
+    const size_t D = (size_t)w->dim;
+    double gmag = 0, ghat[3] = {0, 0, 0};
+    int q, k;
+    for (k = 0; k < w->dim; ++k) gmag += (double)w->def.gravity[k] * (double)w->def.gravity[k];
+    gmag = sqrt(gmag);
+    for (k = 0; k < w->dim; ++k) ghat[k] = gmag > 0 ? (double)w->def.gravity[k] / gmag : 0;
+    for (q = 0; q < w->nphase; ++q) {
+        double smin = 1e300, smax = -1e300, v2max = 0, U, c0;
+        size_t i, count = 0;
+        if (w->phases[q].sound_speed > 0) continue;
+        for (i = 0; i < w->n; ++i) {
+            double s = 0, v2 = 0;
+            if (w->phase[i] != q) continue;
+            ++count;
+            for (k = 0; k < w->dim; ++k) {
+                s += (double)w->x[i * D + (size_t)k] * ghat[k];
+                v2 += (double)w->v[i * D + (size_t)k] * (double)w->v[i * D + (size_t)k];
+            }
+            if (s < smin) smin = s;
+            if (s > smax) smax = s;
+            if (v2 > v2max) v2max = v2;
+        }
+        if (count == 0) continue;
+        U = sqrt(2 * gmag * (smax - smin + (double)w->dx));
+        if (sqrt(v2max) > U) U = sqrt(v2max);
+        c0 = 10 * U;
+        if (!(c0 > 0) || !sph__finite(c0))
+            return sph__fail(w, SPH_ERR_ARG, -1,
+                             "phase %d: sound_speed = 0 asks for an automatic value, but there is "
+                             "no gravity and no motion to derive it from; set sph_phase.sound_speed",
+                             q);
+        w->phases[q].sound_speed = (sph_real)c0;
+    }
+    return SPH_OK;
+}
+
+/* Hydrostatic initial state: per column (bins of width dx across gravity), pressure integrated
+   down from zero at half a spacing above the column's top particle, density from the phase's
+   equation of state. */
+typedef struct sph__hs_item {
+    int64_t bin[2];
+    double s;
+    size_t i;
+} sph__hs_item;
+
+static int sph__hs_cmp(const void* pa, const void* pb) {
+    const sph__hs_item* a = (const sph__hs_item*)pa;
+    const sph__hs_item* b = (const sph__hs_item*)pb;
+    if (a->bin[0] != b->bin[0]) return a->bin[0] < b->bin[0] ? -1 : 1;
+    if (a->bin[1] != b->bin[1]) return a->bin[1] < b->bin[1] ? -1 : 1;
+    if (a->s != b->s) return a->s > b->s ? -1 : 1; /* top first */
+    return a->i < b->i ? -1 : (a->i > b->i ? 1 : 0);
+}
+
+SPHDEF sph_status sph_set_hydrostatic(sph_world* w) {
+    const size_t D = w ? (size_t)w->dim : 0;
+    double gmag = 0, up[3] = {0, 0, 0}, e1[3] = {0, 0, 0}, e2[3] = {0, 0, 0};
+    sph__hs_item* it;
+    sph__ctx c;
+    sph_status s;
+    size_t i, a;
+    int k;
+    if (!w) return SPH_ERR_ARG;
+    if (w->n == 0) return SPH_OK;
+    for (k = 0; k < w->dim; ++k) gmag += (double)w->def.gravity[k] * (double)w->def.gravity[k];
+    gmag = sqrt(gmag);
+    if (!(gmag > 0)) return sph__fail(w, SPH_ERR_ARG, -1, "sph_set_hydrostatic: gravity is zero");
+    s = sph__resolve_sound_speed(w);
+    if (s != SPH_OK) return s;
+    for (k = 0; k < w->dim; ++k) up[k] = -(double)w->def.gravity[k] / gmag;
+    /* an orthonormal basis across gravity: e1 from the axis least aligned with up */
+    if (w->dim >= 2) {
+        int ax = 0;
+        double dot = 0, nrm = 0;
+        for (k = 1; k < w->dim; ++k) if (fabs(up[k]) < fabs(up[ax])) ax = k;
+        e1[ax] = 1;
+        dot = up[ax];
+        for (k = 0; k < 3; ++k) e1[k] -= dot * up[k];
+        for (k = 0; k < 3; ++k) nrm += e1[k] * e1[k];
+        nrm = sqrt(nrm);
+        for (k = 0; k < 3; ++k) e1[k] /= nrm;
+        if (w->dim == 3) {
+            e2[0] = up[1] * e1[2] - up[2] * e1[1];
+            e2[1] = up[2] * e1[0] - up[0] * e1[2];
+            e2[2] = up[0] * e1[1] - up[1] * e1[0];
+        }
+    }
+    it = (sph__hs_item*)SPH_MALLOC(w->n * sizeof(sph__hs_item));
+    if (!it) return sph__fail(w, SPH_ERR_NOMEM, -1, "sph_set_hydrostatic: out of memory");
+    for (i = 0; i < w->n; ++i) {
+        double s1 = 0, s2 = 0, h = 0;
+        for (k = 0; k < w->dim; ++k) {
+            double xk = (double)w->x[i * D + (size_t)k];
+            h += xk * up[k];
+            s1 += xk * e1[k];
+            s2 += xk * e2[k];
+        }
+        it[i].bin[0] = (int64_t)floor(s1 / (double)w->dx + 0.5);
+        it[i].bin[1] = (int64_t)floor(s2 / (double)w->dx + 0.5);
+        it[i].s = h;
+        it[i].i = i;
+    }
+    qsort(it, w->n, sizeof(sph__hs_item), sph__hs_cmp);
+    sph__ctx_init(w, &c);
+    for (a = 0; a < w->n;) {
+        size_t b = a;
+        double p = 0;
+        while (b < w->n && it[b].bin[0] == it[a].bin[0] && it[b].bin[1] == it[a].bin[1]) ++b;
+        for (i = a; i < b; ++i) {
+            size_t j = it[i].i;
+            double rho0 = (double)w->phases[w->phase[j]].rest_density;
+            if (i == a) p = rho0 * gmag * 0.5 * (double)w->dx;
+            else {
+                size_t jp = it[i - 1].i;
+                double rho0p = (double)w->phases[w->phase[jp]].rest_density;
+                p += gmag * 0.5 * (rho0 + rho0p) * (it[i - 1].s - it[i].s);
+            }
+            w->p[j] = (sph_real)p;
+            w->rho[j] = c.pc[w->phase[j]].rho0 * sph__eos_inverse(&c.pc[w->phase[j]], (sph_real)p);
+        }
+        a = b;
+    }
+    SPH_FREE(it);
+    return SPH_OK;
+}
+
+/* A per-particle scratch array of at least `count` reals, kept between steps. */
+static sph_status sph__scratch(sph_world* w, sph_real** p, size_t count) {
+    size_t* cap = p == &w->priv.rho_n ? &w->priv.rho_n_cap : NULL;
+    SPH_ASSERT(cap);
+    if (count <= *cap && *p) return SPH_OK;
+    if (!sph__grow((void**)p, count, sizeof(sph_real)))
+        return sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory (solver scratch)");
+    *cap = count;
+    return SPH_OK;
+}
+
+/* Reorders the persistent arrays of a particle set into the order of a grid build. */
+static void sph__permute(sph_world* w, const sph__array* arr, int narr, const uint32_t* order,
+                         size_t n) {
+    int a;
+    for (a = 0; a < narr; ++a) {
+        const size_t e = arr[a].elem;
+        uint8_t* src = (uint8_t*)*arr[a].ptr;
+        uint8_t* dst = w->priv.perm_buf;
+        sph__idx i;
+        if (!arr[a].persistent) continue;
+        /* fixed-size copies for the common element sizes */
+#define SPH__GATHER(SZ)                                                                            \
+    SPH__OMP_FOR for (i = 0; i < (sph__idx)n; ++i)                                                 \
+        memcpy(dst + (size_t)i * (SZ), src + (size_t)order[i] * (SZ), (SZ))
+        switch (e) {
+        case 1: SPH__GATHER(1); break;
+        case 2: SPH__GATHER(2); break;
+        case 4: SPH__GATHER(4); break;
+        case 8: SPH__GATHER(8); break;
+        case 16: SPH__GATHER(16); break;
+        case 24: SPH__GATHER(24); break;
+        default: SPH__GATHER(e); break;
+        }
+#undef SPH__GATHER
+        memcpy(src, dst, n * e);
+    }
+}
+
+/* Neighbours stage: sort fluid (and moving boundary) particles by cell, then build the lists
+   fluid->fluid, fluid->boundary and boundary->fluid once for the whole step. */
+static sph_status sph__stage_neighbors(sph_world* w) {
+    sph__array arr[16];
+    sph_status s;
+    const sph_real R = w->kernel.radius;
+    int narr;
+    s = sph_grid_build(&w->priv.grid, w->x, w->n);
+    if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour grid: %s", sph_status_string(s));
+    narr = sph__fluid_arrays(w, arr);
+    sph__permute(w, arr, narr, w->priv.grid.order, w->n);
+    if (w->nb > 0 && (w->priv.b_dirty || w->def.boundary_motion)) {
+        s = sph_grid_build(&w->priv.bgrid, w->b_x, w->nb);
+        if (s != SPH_OK) return sph__fail(w, s, -1, "boundary grid: %s", sph_status_string(s));
+        narr = sph__boundary_arrays(w, arr);
+        sph__permute(w, arr, narr, w->priv.bgrid.order, w->nb);
+        w->priv.b_dirty = 0;
+    }
+    s = sph__neighbors_build(&w->priv.ff, &w->priv.grid, w->x, NULL, w->x, w->n, R, 1);
+    if (s == SPH_OK && w->nb > 0) {
+        s = sph__neighbors_build(&w->priv.fb, &w->priv.bgrid, w->b_x, NULL, w->x, w->n, R, 0);
+        if (s == SPH_OK)
+            s = sph__neighbors_build(&w->priv.bf, &w->priv.grid, w->x, NULL, w->b_x, w->nb, R, 0);
+    }
+    if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour lists: %s", sph_status_string(s));
+    w->stats.pairs = w->priv.ff.total;
+#ifdef SPH_VALIDATE
+    { /* every fluid pair is listed from both sides, and every listed pair is within the support */
+        size_t i, kk, q;
+        for (i = 0; i < w->n; ++i) {
+            for (kk = w->priv.ff.begin[i]; kk < w->priv.ff.begin[i] + w->priv.ff.count[i]; ++kk) {
+                size_t j = w->priv.ff.idx[kk], found = 0;
+                for (q = w->priv.ff.begin[j]; q < w->priv.ff.begin[j] + w->priv.ff.count[j]; ++q)
+                    if (w->priv.ff.idx[q] == i) found = 1;
+                SPH_ASSERT(found && j != i);
+            }
+        }
+    }
+#endif
+    return SPH_OK;
+}
+
+/* Summation density (seed 000 eq. 2.4), walls as psi = rho0_i V_b (Akinci et al. 2012):
+       rho_i = m_i W(0) + sum_f m_f W_if + sum_b rho0_i V_b W_ib. */
+static void sph__stage_density_summation(sph_world* w, const sph__ctx* c) {
+    const int D = c->dim;
+    const sph_real w0 = c->k.norm_w * sph__kw(c->k.form, 0);
+    sph__idx i;
+    SPH__OMP_FOR
+    for (i = 0; i < (sph__idx)w->n; ++i) {
+        const sph_real* xi = c->x + (size_t)i * (size_t)D;
+        const sph_real mi = c->m ? c->m[i] : c->m0;
+        sph_real sum = 0, sumb = 0;
+        size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
+        int k;
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t j = c->ff->idx[kk];
+            sph_real d[3] = {0, 0, 0}, r2 = 0;
+            sph__delta_vec(c, xi, c->x + j * (size_t)D, d, D);
+            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+            sum += (c->m ? c->m[j] : c->m0) * sph__kw(c->k.form, sph__sqrt(r2) * c->k.inv_h);
+        }
+        if (c->has_b) {
+            k0 = c->fb->begin[i];
+            k1 = k0 + c->fb->count[i];
+            for (kk = k0; kk < k1; ++kk) {
+                const size_t b = c->fb->idx[kk];
+                sph_real d[3] = {0, 0, 0}, r2 = 0;
+                sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
+                for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+                sumb += c->bvol[b] * sph__kw(c->k.form, sph__sqrt(r2) * c->k.inv_h);
+            }
+        }
+        w->rho[i] = mi * w0 + c->k.norm_w * (sum + c->pc[c->ph[i]].rho0 * sumb);
+    }
+}
+
+static void sph__stage_eos(sph_world* w, const sph__ctx* c) {
+    const int clamp = w->def.clamp == SPH_CLAMP_ON ||
+                      (w->def.clamp == SPH_CLAMP_AUTO && w->def.density == SPH_DENSITY_SUMMATION);
+    sph__idx i;
+    SPH__OMP_FOR
+    for (i = 0; i < (sph__idx)w->n; ++i) {
+        const sph_real p = sph__eos(&c->pc[c->ph[i]], w->rho[i]);
+        w->p[i] = clamp && p < 0 ? 0 : p;
+    }
+}
+
+enum { SPH__ACCEL = 1, SPH__RATE = 2 };
+
+/* The one neighbour loop for accelerations and the density rate of fluid particle i.
+   ACCEL: pressure gradient (seed 000 sec. 2.2.1: sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W_ij,
+          or the multiphase form (p_i + p_j)/(rho_i rho_j), Ott & Schnetter eq. 12), laminar
+          viscosity (Monaghan 2005: 2(d+2) sum_j m_j nu_bar/rho_bar v_ij.x_ij/(r^2+eta^2) grad W),
+          Monaghan 1992 artificial viscosity
+          Pi_ij = (-alpha c_bar mu_ij + beta mu_ij^2)/rho_bar, mu_ij = h v_ij.x_ij/(r^2+eta^2) when
+          v_ij.x_ij < 0, gravity. [m/s^2]
+   RATE:  continuity d rho_i/dt = sum_j m_j v_ij . grad W_ij (seed 000 eq. 2.2), or m_i in place
+          of m_j (Ott & Schnetter eq. 11), plus delta-SPH diffusion (Molteni & Colagrossi 2009,
+          seed 000 sec. 3.2.1) written with densities relative to each phase's rest density:
+          delta h c0 sum_j 2 rho0_i V_j (rho_i/rho0_i - rho_j/rho0_j) x_ij.grad W_ij/(r^2+eta^2),
+          which is seed 000's term for one phase and does not diffuse across a phase interface.
+          [kg/m^3/s] */
+SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, const int flags,
+                                   sph_real* acc, sph_real* rate) {
+    const sph_real* xi = c->x + i * (size_t)D;
+    const sph_real* vi = c->v + i * (size_t)D;
+    const sph__phase_c* P = &c->pc[c->ph[i]];
+    const sph_real rhoi = c->rho[i], pi = c->p[i], mi = c->m ? c->m[i] : c->m0;
+    const sph_real inv_rhoi = 1 / rhoi, pi_r2 = pi * inv_rhoi * inv_rhoi;
+    const sph_real rhati = rhoi * P->inv_rho0;
+    const sph_real dcoef = c->delta * c->h * P->c0 * 2 * P->rho0;
+    const int os = c->density == SPH_DENSITY_PARTICLE;
+    sph_real ai[3] = {0, 0, 0}, R = 0;
+    size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
+    int k;
+    for (kk = k0; kk < k1; ++kk) {
+        const size_t j = c->ff->idx[kk];
+        const sph_real* xj = c->x + j * (size_t)D;
+        const sph_real* vj = c->v + j * (size_t)D;
+        const sph__phase_c* Pj = &c->pc[c->ph[j]];
+        const sph_real mj = c->m ? c->m[j] : c->m0, rhoj = c->rho[j];
+        sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, fw;
+        sph__delta_vec(c, xi, xj, d, D);
+        for (k = 0; k < D; ++k) {
+            r2 += d[k] * d[k];
+            vd += (vi[k] - vj[k]) * d[k];
+        }
+        fw = c->k.norm_g * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h); /* grad W = fw d */
+        if (flags & SPH__RATE) {
+            R += (os ? mi : mj) * fw * vd;
+            if (c->delta_on)
+                R += dcoef * (mj / rhoj) * (rhati - rhoj * Pj->inv_rho0) * fw * r2 / (r2 + c->eta2);
+        }
+        if (flags & SPH__ACCEL) {
+            const sph_real pj = c->p[j];
+            sph_real s;
+            if (c->pgrad == SPH_PGRAD_SYMMETRIC) s = -mj * (pi_r2 + pj / (rhoj * rhoj));
+            else s = -mj * (pi + pj) * inv_rhoi / rhoj;
+            if (c->laminar) s += c->visc_k * mj * (P->mu + Pj->mu) * inv_rhoi / rhoj * vd / (r2 + c->eta2);
+            if (c->av && vd < 0) {
+                const sph_real mu = c->h * vd / (r2 + c->eta2);
+                const sph_real cbar = SPH__R(0.5) * (P->c0 + Pj->c0);
+                s -= mj * (-c->alpha * cbar * mu + c->beta * mu * mu) * 2 / (rhoi + rhoj);
+            }
+            s *= fw;
+            for (k = 0; k < D; ++k) ai[k] += s * d[k];
+        }
+    }
+    if (c->has_b) {
+        k0 = c->fb->begin[i];
+        k1 = k0 + c->fb->count[i];
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t b = c->fb->idx[kk];
+            const sph_real* xb = c->bx + b * (size_t)D;
+            const sph_real Vb = c->bvol[b], psi = P->rho0 * Vb, kap = c->brho[b];
+            const sph_real rhob = P->rho0 * kap;
+            sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, fw;
+            sph__delta_vec(c, xi, xb, d, D);
+            for (k = 0; k < D; ++k) {
+                r2 += d[k] * d[k];
+                vd += (vi[k] - c->bv[b * (size_t)D + (size_t)k]) * d[k];
+            }
+            fw = c->k.norm_g * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h);
+            if (flags & SPH__RATE) {
+                R += psi * fw * vd; /* the wall's own velocity: a moving wall compresses */
+                if (c->delta_on) R += dcoef * Vb * (rhati - kap) * fw * r2 / (r2 + c->eta2);
+            }
+            if (flags & SPH__ACCEL) {
+                const sph_real pb = c->bp[b];
+                sph_real s;
+                if (c->pgrad == SPH_PGRAD_SYMMETRIC) s = -psi * (pi_r2 + pb / (rhob * rhob));
+                else s = -psi * (pi + pb) * inv_rhoi / rhob;
+                if (c->noslip && (c->laminar || c->av)) {
+                    sph_real vg = 0;
+                    for (k = 0; k < D; ++k) vg += (vi[k] - c->bvw[b * (size_t)D + (size_t)k]) * d[k];
+                    if (c->laminar) s += c->visc_k * psi * 2 * P->mu * inv_rhoi / rhob * vg / (r2 + c->eta2);
+                    if (c->av && vg < 0) {
+                        const sph_real mu = c->h * vg / (r2 + c->eta2);
+                        s -= psi * (-c->alpha * P->c0 * mu + c->beta * mu * mu) * 2 / (rhoi + rhob);
+                    }
+                }
+                s *= fw;
+                for (k = 0; k < D; ++k) ai[k] += s * d[k];
+            }
+        }
+    }
+    if (flags & SPH__ACCEL)
+        for (k = 0; k < D; ++k) acc[i * (size_t)D + (size_t)k] = ai[k] + c->g[k];
+    if (flags & SPH__RATE) rate[i] = R;
+}
+
+#define SPH__BLOCK 256 /* particles per parallel work item (and per force-callback call) */
+
+static void sph__stage_interact(sph_world* w, const sph__ctx* c, int flags) {
+    const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
+    sph__idx blk;
+    SPH__OMP_FOR
+    for (blk = 0; blk < (sph__idx)nblk; ++blk) {
+        const size_t i0 = (size_t)blk * SPH__BLOCK;
+        const size_t i1 = i0 + SPH__BLOCK < w->n ? i0 + SPH__BLOCK : w->n;
+        size_t i;
+#define SPH__LOOP(D, FL) for (i = i0; i < i1; ++i) sph__interact_one(c, i, D, FL, w->a, w->drho)
+        switch (c->dim * 4 + flags) {
+        case 1 * 4 + SPH__ACCEL: SPH__LOOP(1, SPH__ACCEL); break;
+        case 1 * 4 + SPH__RATE: SPH__LOOP(1, SPH__RATE); break;
+        case 2 * 4 + SPH__ACCEL: SPH__LOOP(2, SPH__ACCEL); break;
+        case 2 * 4 + SPH__RATE: SPH__LOOP(2, SPH__RATE); break;
+        case 3 * 4 + SPH__ACCEL: SPH__LOOP(3, SPH__ACCEL); break;
+        case 3 * 4 + SPH__RATE: SPH__LOOP(3, SPH__RATE); break;
+        default: SPH_ASSERT(0); break;
+        }
+#undef SPH__LOOP
+        if ((flags & SPH__ACCEL) && w->def.force) w->def.force(w, i0, i1, w->a, w->def.force_user);
+    }
+}
+
+/* Rejects a step on input that would poison it: dt, and non-finite positions, velocities or
+   densities written by the host between steps. Nothing is changed. */
+static sph_status sph__check_step_input(sph_world* w, sph_real dt) {
+    const size_t D = (size_t)w->dim;
+    size_t i, k;
+    if (!sph__finite((double)dt) || !(dt > 0))
+        return sph__fail(w, SPH_ERR_ARG, -1, "step: dt = %g: must be finite and > 0", (double)dt);
+    if (w->nphase == 0 && w->n > 0)
+        return sph__fail(w, SPH_ERR_ARG, -1, "step: the world has particles but no phase");
+    for (i = 0; i < w->n; ++i) {
+        for (k = 0; k < D; ++k) {
+            if (!sph__finite((double)w->x[i * D + k]))
+                return sph__fail(w, SPH_ERR_ARG, (long)i,
+                                 "step: fluid particle %zu (id %u) has a non-finite position", i,
+                                 (unsigned)w->id[i]);
+            if (!sph__finite((double)w->v[i * D + k]))
+                return sph__fail(w, SPH_ERR_ARG, (long)i,
+                                 "step: fluid particle %zu (id %u) has a non-finite velocity", i,
+                                 (unsigned)w->id[i]);
+        }
+        if (!sph__finite((double)w->rho[i]) || !(w->rho[i] > 0))
+            return sph__fail(w, SPH_ERR_ARG, (long)i,
+                             "step: fluid particle %zu (id %u) has density %g: must be finite and > 0",
+                             i, (unsigned)w->id[i], (double)w->rho[i]);
+    }
+    for (i = 0; i < w->nb * D; ++i)
+        if (!sph__finite((double)w->b_x[i]) || !sph__finite((double)w->b_v[i]))
+            return sph__fail(w, SPH_ERR_ARG, (long)(i / D),
+                             "step: boundary particle %zu has a non-finite position or velocity",
+                             i / D);
+    return SPH_OK;
+}
+
+static sph_status sph__boundary_motion(sph_world* w, double t) {
+    const size_t D = (size_t)w->dim;
+    size_t i;
+    if (!w->def.boundary_motion || w->nb == 0) return SPH_OK;
+    w->def.boundary_motion(w, t, w->def.boundary_user);
+    for (i = 0; i < w->nb * D; ++i)
+        if (!sph__finite((double)w->b_x[i]) || !sph__finite((double)w->b_v[i]) ||
+            !sph__finite((double)w->b_a[i]))
+            return sph__fail(w, SPH_ERR_ARG, (long)(i / D),
+                             "boundary motion callback: boundary particle %zu (id %u) got a "
+                             "non-finite position, velocity or acceleration at t = %g",
+                             i / D, (unsigned)w->b_id[i / D], t);
+    return SPH_OK;
+}
+
+/* Integration update v += kv a, rho += kr drho, x += kx v (in that order), periodic wrap. With
+   `final`, also the step's diagnostics and blow-up detection. Reductions run over fixed blocks
+   combined in block order, so the result does not depend on the number of threads. */
+enum { SPH__RED_KE, SPH__RED_ERRSUM, SPH__RED_ERRMAX, SPH__RED_V2MAX, SPH__RED_A2MAX,
+       SPH__RED_OUT, SPH__RED_BAD, SPH__RED_KIND, SPH__RED_N };
+enum { SPH__BAD_NONE, SPH__BAD_NONFINITE, SPH__BAD_DENSITY, SPH__BAD_COMPRESSION, SPH__BAD_SPEED };
+
+static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, sph_real kr,
+                                 sph_real kx, int final) {
+    const int D = w->dim;
+    const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
+    sph_real vlim = w->def.max_speed;
+    double red[SPH__RED_N];
+    sph__idx blk;
+    size_t q;
+    int k;
+    if (vlim <= 0) {
+        int ph;
+        for (ph = 0; ph < w->nphase; ++ph) vlim = sph__max(vlim, w->phases[ph].sound_speed);
+    }
+    if (nblk * SPH__RED_N > w->priv.block_cap) {
+        size_t cap = nblk * SPH__RED_N + 64;
+        if (!sph__grow((void**)&w->priv.block, cap, sizeof(double)))
+            return sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory (reduction blocks)");
+        w->priv.block_cap = cap;
+    }
+    SPH__OMP_FOR
+    for (blk = 0; blk < (sph__idx)nblk; ++blk) {
+        const size_t i0 = (size_t)blk * SPH__BLOCK;
+        const size_t i1 = i0 + SPH__BLOCK < w->n ? i0 + SPH__BLOCK : w->n;
+        double* r = w->priv.block + (size_t)blk * SPH__RED_N;
+        size_t i;
+        int kk;
+        for (kk = 0; kk < SPH__RED_N; ++kk) r[kk] = 0;
+        r[SPH__RED_BAD] = -1;
+        for (i = i0; i < i1; ++i) {
+            sph_real* xi = w->x + i * (size_t)D;
+            sph_real* vi = w->v + i * (size_t)D;
+            const sph_real* ai = w->a + i * (size_t)D;
+            double v2 = 0, a2 = 0, err, mi;
+            int out = 0, bad = SPH__BAD_NONE;
+            if (kv != 0) for (kk = 0; kk < D; ++kk) vi[kk] += kv * ai[kk];
+            if (kr != 0) w->rho[i] += kr * w->drho[i];
+            for (kk = 0; kk < D; ++kk) {
+                if (kx != 0) xi[kk] += kx * vi[kk];
+                if (c->per[kk]) {
+                    const sph_real lo = w->def.domain_lo[kk];
+                    if (xi[kk] < lo || xi[kk] >= lo + c->len[kk])
+                        xi[kk] -= c->len[kk] * sph__floor((xi[kk] - lo) / c->len[kk]);
+                    if (xi[kk] >= lo + c->len[kk]) xi[kk] = lo; /* rounding at the top edge */
+                }
+            }
+            if (!final) continue;
+            mi = (double)(w->m ? w->m[i] : w->priv.mass);
+            for (kk = 0; kk < D; ++kk) {
+                v2 += (double)vi[kk] * (double)vi[kk];
+                a2 += (double)ai[kk] * (double)ai[kk];
+                if (!sph__finite((double)xi[kk])) bad = SPH__BAD_NONFINITE;
+                if (!c->per[kk] && w->def.domain_lo[kk] < w->def.domain_hi[kk] &&
+                    (xi[kk] < w->def.domain_lo[kk] || xi[kk] > w->def.domain_hi[kk]))
+                    out = 1;
+            }
+            err = (double)(w->rho[i] * c->pc[w->phase[i]].inv_rho0) - 1;
+            if (!sph__finite(v2) || !sph__finite((double)w->rho[i])) bad = SPH__BAD_NONFINITE;
+            else if (!(w->rho[i] > 0)) bad = SPH__BAD_DENSITY;
+            else if (w->def.max_compression > 0 && err > (double)w->def.max_compression)
+                bad = SPH__BAD_COMPRESSION;
+            else if (vlim > 0 && v2 > (double)vlim * (double)vlim) bad = SPH__BAD_SPEED;
+            r[SPH__RED_KE] += 0.5 * mi * v2;
+            r[SPH__RED_ERRSUM] += fabs(err);
+            if (fabs(err) > r[SPH__RED_ERRMAX]) r[SPH__RED_ERRMAX] = fabs(err);
+            if (v2 > r[SPH__RED_V2MAX]) r[SPH__RED_V2MAX] = v2;
+            if (a2 > r[SPH__RED_A2MAX]) r[SPH__RED_A2MAX] = a2;
+            r[SPH__RED_OUT] += out;
+            if (bad != SPH__BAD_NONE && r[SPH__RED_BAD] < 0) {
+                r[SPH__RED_BAD] = (double)i;
+                r[SPH__RED_KIND] = bad;
+            }
+        }
+    }
+    if (!final) return SPH_OK;
+    for (k = 0; k < SPH__RED_N; ++k) red[k] = 0;
+    red[SPH__RED_BAD] = -1;
+    for (q = 0; q < nblk; ++q) {
+        const double* r = w->priv.block + q * SPH__RED_N;
+        red[SPH__RED_KE] += r[SPH__RED_KE];
+        red[SPH__RED_ERRSUM] += r[SPH__RED_ERRSUM];
+        if (r[SPH__RED_ERRMAX] > red[SPH__RED_ERRMAX]) red[SPH__RED_ERRMAX] = r[SPH__RED_ERRMAX];
+        if (r[SPH__RED_V2MAX] > red[SPH__RED_V2MAX]) red[SPH__RED_V2MAX] = r[SPH__RED_V2MAX];
+        if (r[SPH__RED_A2MAX] > red[SPH__RED_A2MAX]) red[SPH__RED_A2MAX] = r[SPH__RED_A2MAX];
+        red[SPH__RED_OUT] += r[SPH__RED_OUT];
+        if (red[SPH__RED_BAD] < 0 && r[SPH__RED_BAD] >= 0) {
+            red[SPH__RED_BAD] = r[SPH__RED_BAD];
+            red[SPH__RED_KIND] = r[SPH__RED_KIND];
+        }
+    }
+    w->stats.kinetic_energy = red[SPH__RED_KE];
+    w->stats.density_error_avg = w->n ? red[SPH__RED_ERRSUM] / (double)w->n : 0;
+    w->stats.density_error_max = red[SPH__RED_ERRMAX];
+    w->stats.v_max = sqrt(red[SPH__RED_V2MAX]);
+    w->stats.a_max = sqrt(red[SPH__RED_A2MAX]);
+    w->stats.n_outside = (size_t)red[SPH__RED_OUT];
+    if (red[SPH__RED_BAD] >= 0) {
+        const size_t i = (size_t)red[SPH__RED_BAD];
+        const int kind = (int)red[SPH__RED_KIND];
+        const double rr = (double)(w->rho[i] * c->pc[w->phase[i]].inv_rho0);
+        double v2 = 0;
+        for (k = 0; k < D; ++k) v2 += (double)w->v[i * (size_t)D + (size_t)k] * (double)w->v[i * (size_t)D + (size_t)k];
+        switch (kind) {
+        case SPH__BAD_NONFINITE:
+            return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
+                             "step %llu (t = %g s): fluid particle %zu (id %u) became non-finite",
+                             (unsigned long long)w->steps, w->time, i, (unsigned)w->id[i]);
+        case SPH__BAD_DENSITY:
+            return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
+                             "step %llu (t = %g s): fluid particle %zu (id %u) has density %g <= 0",
+                             (unsigned long long)w->steps, w->time, i, (unsigned)w->id[i],
+                             (double)w->rho[i]);
+        case SPH__BAD_COMPRESSION:
+            return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
+                             "step %llu (t = %g s): fluid particle %zu (id %u) compressed to "
+                             "rho/rho0 = %g (max_compression %g): time step too large or "
+                             "sound speed too low",
+                             (unsigned long long)w->steps, w->time, i, (unsigned)w->id[i], rr,
+                             (double)w->def.max_compression);
+        default:
+            return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
+                             "step %llu (t = %g s): fluid particle %zu (id %u) moves at %g m/s, "
+                             "above the limit %g m/s",
+                             (unsigned long long)w->steps, w->time, i, (unsigned)w->id[i], sqrt(v2),
+                             (double)vlim);
+        }
+    }
+    return SPH_OK;
+}
+
+/* Common start of every step: input checks, automatic sound speeds, stats reset. */
+static sph_status sph__step_begin(sph_world* w, sph_real dt) {
+    sph_status s;
+    int k;
+    if (!w) return SPH_ERR_ARG;
+    s = sph__check_step_input(w, dt);
+    if (s != SPH_OK) return s;
+    s = sph__resolve_sound_speed(w);
+    if (s != SPH_OK) return s;
+    for (k = 0; k < SPH_STAGE_COUNT; ++k) w->stats.stage_time[k] = 0;
+    w->stats.dt = (double)dt;
+    w->stats.iterations = 1;
+    w->error[0] = 0;
+    w->error_index = -1;
+    w->status = SPH_OK;
+    return SPH_OK;
+}
+
+/* Boundary motion at time t, neighbour search, summation density if chosen, equation of state,
+   wall extrapolation: the state every force evaluation starts from. */
+static sph_status sph__prepare_forces(sph_world* w, sph__ctx* c, double t, double* t0) {
+    sph_status s = sph__boundary_motion(w, t);
+    if (s != SPH_OK) return s;
+    sph__time(w, SPH_STAGE_BOUNDARY, t0);
+    s = sph__stage_neighbors(w);
+    if (s != SPH_OK) return s;
+    sph__ctx_init(w, c); /* after the sort: the arrays are the same, their content moved */
+    sph__time(w, SPH_STAGE_NEIGHBORS, t0);
+    if (w->def.density == SPH_DENSITY_SUMMATION) {
+        sph__stage_density_summation(w, c);
+        sph__time(w, SPH_STAGE_DENSITY, t0);
+    }
+    sph__stage_eos(w, c);
+    if (w->nb > 0) sph__stage_wall_pressure(w, c);
+    sph__time(w, SPH_STAGE_PRESSURE, t0);
+    return SPH_OK;
+}
+
+/* ============================================================================================== */
+/* >>wcsph (implementation)                                                                       */
+/* ============================================================================================== */
+/* Symplectic Euler (seed 000 sec. 2.3, "semi-implicit"):
+       v^{n+1}   = v^n + dt a(x^n, rho^n, v^n)
+       rho^{n+1} = rho^n + dt R(x^n, v^{n+1})          R = density rate (continuity + delta-SPH)
+       x^{n+1}   = x^n + dt v^{n+1}
+   The density must see the new velocity: with R(x^n, v^n) the acoustic pair (rho, v) would be
+   integrated by forward Euler, which is unconditionally unstable (a tank at rest blows up within
+   a few hundred steps). So a step is two neighbour passes over the same lists: forces, then the
+   density rate.
+   Stormer-Verlet, drift-kick-drift (seed 000 sec. 2.3). Seed 000 leaves open how the density
+   joins the half steps (digest sec. 12 d). Decision: rho is a position-like variable advanced by
+   the midpoint rule, R being linear in v:
+       x^{n+1/2}   = x^n + dt/2 v^n
+       rho~        = rho^n + dt/2 R_prev            (predictor, used only for the forces)
+       v^{n+1}     = v^n + dt a(x^{n+1/2}, rho~, v^n)
+       rho^{n+1}   = rho^n + dt R(x^{n+1/2}, (v^n + v^{n+1})/2)
+       x^{n+1}     = x^{n+1/2} + dt/2 v^{n+1}
+   R_prev is the previous step's rate; its lag makes rho~ wrong by O(dt^2), which changes the
+   forces by O(dt^2), so the step stays second order (tests/test_wcsph.c measures the order).
+   The kick is split in two halves so the rate pass sees the mean velocity. Two passes per step. */
+static sph_status sph__step_wcsph_euler(sph_world* w, sph_real dt) {
+    const int cont = w->def.density != SPH_DENSITY_SUMMATION;
+    double t0 = sph__now(), tstart = t0;
+    sph__ctx c;
+    sph_status s = sph__prepare_forces(w, &c, w->time, &t0);
+    if (s != SPH_OK) return s;
+    sph__stage_interact(w, &c, SPH__ACCEL);
+    sph__time(w, SPH_STAGE_FORCES, &t0);
+    s = sph__integrate(w, &c, dt, 0, 0, 0); /* kick */
+    if (s != SPH_OK) return s;
+    if (cont) {
+        sph__stage_interact(w, &c, SPH__RATE);
+        sph__time(w, SPH_STAGE_DENSITY, &t0);
+    }
+    ++w->steps;
+    w->time += (double)dt;
+    s = sph__integrate(w, &c, 0, cont ? dt : 0, dt, 1); /* density and drift */
+    sph__time(w, SPH_STAGE_INTEGRATE, &t0);
+    w->stats.step_time = sph__now() - tstart;
+    return s;
+}
+
+static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
+    const int cont = w->def.density != SPH_DENSITY_SUMMATION;
+    const sph_real half = SPH__R(0.5) * dt;
+    double t0 = sph__now(), tstart = t0;
+    sph__ctx c;
+    sph_status s;
+    sph__idx i;
+    if (cont) { /* scratch for rho^n */
+        s = sph__scratch(w, &w->priv.rho_n, w->capacity);
+        if (s != SPH_OK) return s;
+    }
+    sph__ctx_init(w, &c);
+    s = sph__integrate(w, &c, 0, 0, half, 0); /* drift */
+    if (s != SPH_OK) return s;
+    sph__time(w, SPH_STAGE_INTEGRATE, &t0);
+    s = sph__boundary_motion(w, w->time + (double)half);
+    if (s != SPH_OK) return s;
+    sph__time(w, SPH_STAGE_BOUNDARY, &t0);
+    s = sph__stage_neighbors(w);
+    if (s != SPH_OK) return s;
+    sph__ctx_init(w, &c);
+    sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
+    if (cont) {
+        SPH__OMP_FOR
+        for (i = 0; i < (sph__idx)w->n; ++i) {
+            w->priv.rho_n[i] = w->rho[i];
+            w->rho[i] += half * w->drho[i];
+        }
+    } else {
+        sph__stage_density_summation(w, &c);
+    }
+    sph__time(w, SPH_STAGE_DENSITY, &t0);
+    sph__stage_eos(w, &c);
+    if (w->nb > 0) sph__stage_wall_pressure(w, &c);
+    sph__time(w, SPH_STAGE_PRESSURE, &t0);
+    sph__stage_interact(w, &c, SPH__ACCEL);
+    sph__time(w, SPH_STAGE_FORCES, &t0);
+    s = sph__integrate(w, &c, half, 0, 0, 0); /* half kick: v = (v^n + v^{n+1}) / 2 */
+    if (s != SPH_OK) return s;
+    if (cont) {
+        sph__stage_interact(w, &c, SPH__RATE);
+        SPH__OMP_FOR
+        for (i = 0; i < (sph__idx)w->n; ++i) w->rho[i] = w->priv.rho_n[i] + dt * w->drho[i];
+        sph__time(w, SPH_STAGE_DENSITY, &t0);
+    }
+    ++w->steps;
+    w->time += (double)dt;
+    s = sph__integrate(w, &c, half, 0, half, 1); /* half kick, drift */
+    sph__time(w, SPH_STAGE_INTEGRATE, &t0);
+    w->stats.step_time = sph__now() - tstart;
+    return s;
+}
+
+SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt) {
+    sph_status s = sph__step_begin(w, dt);
+    if (s != SPH_OK) return s;
+    if (w->def.integrator == SPH_INTEGRATOR_VERLET) return sph__step_wcsph_verlet(w, dt);
+    return sph__step_wcsph_euler(w, dt);
+}
+
+/* >>stages: time step control */
+
+SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
+    const size_t D = w ? (size_t)w->dim : 0;
+    double cmax = 0, numax = 0, v2max = 0, amax, dt, g2 = 0;
+    size_t i, k;
+    int q;
+    if (!w) return 0;
+    if (solver != SPH_SOLVER_WCSPH) {
+        sph__fail(w, SPH_ERR_ARG, -1, "sph_stable_dt: solver %d is not a sph_solver", (int)solver);
+        return 0;
+    }
+    if (sph__resolve_sound_speed(w) != SPH_OK) return 0;
+    for (q = 0; q < w->nphase; ++q) {
+        if ((double)w->phases[q].sound_speed > cmax) cmax = (double)w->phases[q].sound_speed;
+        if ((double)w->phases[q].viscosity > numax) numax = (double)w->phases[q].viscosity;
+    }
+    for (i = 0; i < w->n * D; i += D) {
+        double v2 = 0;
+        for (k = 0; k < D; ++k) v2 += (double)w->v[i + k] * (double)w->v[i + k];
+        if (v2 > v2max) v2max = v2;
+    }
+    for (i = 0; i < w->nb * D; i += D) {
+        double v2 = 0;
+        for (k = 0; k < D; ++k) v2 += (double)w->b_v[i + k] * (double)w->b_v[i + k];
+        if (v2 > v2max) v2max = v2;
+    }
+    for (k = 0; k < D; ++k) g2 += (double)w->def.gravity[k] * (double)w->def.gravity[k];
+    amax = w->steps > 0 ? w->stats.a_max : sqrt(g2);
+    if (!(cmax > 0)) {
+        sph__fail(w, SPH_ERR_ARG, -1, "sph_stable_dt: no phase has a sound speed (add particles)");
+        return 0;
+    }
+    dt = (double)w->def.cfl * (double)w->h / (cmax + sqrt(v2max));
+    if (numax > 0) dt = fmin(dt, (double)w->def.cfl_viscous * (double)w->h * (double)w->h / numax);
+    if (amax > 0) dt = fmin(dt, (double)w->def.cfl_force * sqrt((double)w->h / amax));
+    return (sph_real)dt;
+}
+
+SPHDEF sph_status sph_step(sph_world* w, sph_real dt) {
+    if (!w) return SPH_ERR_ARG;
+    switch (w->def.solver) {
+    case SPH_SOLVER_WCSPH: return sph_step_wcsph(w, dt);
+    default: return sph__fail(w, SPH_ERR_ARG, -1, "sph_step: unknown solver %d", (int)w->def.solver);
+    }
+}
+
+SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
+    double t_end, remaining;
+    if (!w) return SPH_ERR_ARG;
+    if (!sph__finite((double)duration) || duration < 0)
+        return sph__fail(w, SPH_ERR_ARG, -1, "sph_advance: duration = %g: must be finite and >= 0",
+                         (double)duration);
+    t_end = w->time + (double)duration;
+    remaining = (double)duration;
+    while (remaining > 1e-12 * (fabs(t_end) > 1 ? fabs(t_end) : 1)) {
+        double dt = (double)sph_stable_dt(w, w->def.solver);
+        sph_status s;
+        if (!(dt > 0)) {
+            if (w->status == SPH_OK) sph__fail(w, SPH_ERR_UNSTABLE, -1, "sph_advance: no stable dt");
+            return w->status;
+        }
+        if (dt < 1e-12 * (double)duration)
+            return sph__fail(w, SPH_ERR_UNSTABLE, -1,
+                             "sph_advance: the stable time step collapsed to %g s at t = %g s", dt,
+                             w->time);
+        if (remaining <= dt) dt = remaining;
+        else if (remaining < 2 * dt) dt = 0.5 * remaining; /* no sliver of a last step */
+        s = sph_step(w, (sph_real)dt);
+        if (s != SPH_OK) return s;
+        remaining = t_end - w->time;
+    }
+    return SPH_OK;
+}
+
+/* ============================================================================================== */
+/* >>io (implementation)                                                                          */
+/* ============================================================================================== */
+
+SPHDEF sph_status sph_write_csv(const sph_world* w, const char* path) {
+    const char* names = "xyz";
+    FILE* f;
+    size_t i;
+    int k;
+    if (!w || !path) return SPH_ERR_ARG;
+    f = fopen(path, "w");
+    if (!f) return SPH_ERR_ARG;
+    fprintf(f, "id,phase");
+    for (k = 0; k < w->dim; ++k) fprintf(f, ",%c", names[k]);
+    for (k = 0; k < w->dim; ++k) fprintf(f, ",v%c", names[k]);
+    fprintf(f, ",rho,p\n");
+    for (i = 0; i < w->n; ++i) {
+        fprintf(f, "%u,%u", (unsigned)w->id[i], (unsigned)w->phase[i]);
+        for (k = 0; k < w->dim; ++k) fprintf(f, ",%.9g", (double)w->x[i * (size_t)w->dim + (size_t)k]);
+        for (k = 0; k < w->dim; ++k) fprintf(f, ",%.9g", (double)w->v[i * (size_t)w->dim + (size_t)k]);
+        fprintf(f, ",%.9g,%.9g\n", (double)w->rho[i], (double)w->p[i]);
+    }
+    return fclose(f) == 0 ? SPH_OK : SPH_ERR_ARG;
+}
+
+SPHDEF sph_status sph_write_vtk(const sph_world* w, const char* path) {
+    FILE* f;
+    size_t i, n;
+    int k;
+    if (!w || !path) return SPH_ERR_ARG;
+    f = fopen(path, "w");
+    if (!f) return SPH_ERR_ARG;
+    n = w->n + w->nb;
+    fprintf(f, "# vtk DataFile Version 3.0\nsph.h particles t=%.9g\nASCII\nDATASET UNSTRUCTURED_GRID\n",
+            w->time);
+    fprintf(f, "POINTS %zu double\n", n);
+    for (i = 0; i < n; ++i) {
+        const sph_real* x = i < w->n ? w->x + i * (size_t)w->dim : w->b_x + (i - w->n) * (size_t)w->dim;
+        for (k = 0; k < 3; ++k) fprintf(f, "%.9g%c", k < w->dim ? (double)x[k] : 0.0, k < 2 ? ' ' : '\n');
+    }
+    fprintf(f, "CELLS %zu %zu\n", n, 2 * n);
+    for (i = 0; i < n; ++i) fprintf(f, "1 %zu\n", i);
+    fprintf(f, "CELL_TYPES %zu\n", n);
+    for (i = 0; i < n; ++i) fprintf(f, "1\n");
+    fprintf(f, "POINT_DATA %zu\nSCALARS kind int 1\nLOOKUP_TABLE default\n", n);
+    for (i = 0; i < n; ++i) fprintf(f, "%d\n", i < w->n ? 0 : 1);
+    fprintf(f, "SCALARS id int 1\nLOOKUP_TABLE default\n");
+    for (i = 0; i < n; ++i) fprintf(f, "%u\n", i < w->n ? (unsigned)w->id[i] : (unsigned)w->b_id[i - w->n]);
+    fprintf(f, "SCALARS phase int 1\nLOOKUP_TABLE default\n");
+    for (i = 0; i < n; ++i) fprintf(f, "%d\n", i < w->n ? (int)w->phase[i] : -1);
+    fprintf(f, "SCALARS density double 1\nLOOKUP_TABLE default\n");
+    for (i = 0; i < n; ++i) fprintf(f, "%.9g\n", i < w->n ? (double)w->rho[i] : (double)w->b_rho[i - w->n]);
+    fprintf(f, "SCALARS pressure double 1\nLOOKUP_TABLE default\n");
+    for (i = 0; i < n; ++i) fprintf(f, "%.9g\n", i < w->n ? (double)w->p[i] : (double)w->b_p[i - w->n]);
+    fprintf(f, "VECTORS velocity double\n");
+    for (i = 0; i < n; ++i) {
+        const sph_real* v = i < w->n ? w->v + i * (size_t)w->dim : w->b_v + (i - w->n) * (size_t)w->dim;
+        for (k = 0; k < 3; ++k) fprintf(f, "%.9g%c", k < w->dim ? (double)v[k] : 0.0, k < 2 ? ' ' : '\n');
+    }
+    return fclose(f) == 0 ? SPH_OK : SPH_ERR_ARG;
+}
+
+#endif /* SPH__IMPLEMENTATION_ONCE */
+#endif /* SPH_IMPLEMENTATION */
+
+/*
+------------------------------------------------------------------------------
+MIT License
+
+Copyright (c) 2026 the sph.h authors
+
+Permission is hereby granted, free of charge, to any person obtaining a copy of
+this software and associated documentation files (the "Software"), to deal in
+the Software without restriction, including without limitation the rights to
+use, copy, modify, merge, publish, distribute, sublicense, and/or sell copies
+of the Software, and to permit persons to whom the Software is furnished to do
+so, subject to the following conditions:
+
+The above copyright notice and this permission notice shall be included in all
+copies or substantial portions of the Software.
+
+THE SOFTWARE IS PROVIDED "AS IS", WITHOUT WARRANTY OF ANY KIND, EXPRESS OR
+IMPLIED, INCLUDING BUT NOT LIMITED TO THE WARRANTIES OF MERCHANTABILITY,
+FITNESS FOR A PARTICULAR PURPOSE AND NONINFRINGEMENT. IN NO EVENT SHALL THE
+AUTHORS OR COPYRIGHT HOLDERS BE LIABLE FOR ANY CLAIM, DAMAGES OR OTHER
+LIABILITY, WHETHER IN AN ACTION OF CONTRACT, TORT OR OTHERWISE, ARISING FROM,
+OUT OF OR IN CONNECTION WITH THE SOFTWARE OR THE USE OR OTHER DEALINGS IN THE
+SOFTWARE.
+------------------------------------------------------------------------------
+*/
