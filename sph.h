@@ -1,5 +1,161 @@
 /* sph.h - smoothed particle hydrodynamics in one header. MIT licence (see end of file).
-@@DOCS@@
+
+   A plain-struct particle world, SPH kernels, a cell grid for neighbour search, and time steps
+   for weakly compressible SPH with dummy-particle walls, moving boundaries and user forces.
+   C99, also C++; libc and libm only; OpenMP when the compiler enables it.
+
+   DO THIS in exactly one C or C++ file:
+
+       #define SPH_IMPLEMENTATION
+       #include "sph.h"
+
+   and include sph.h without the define everywhere else.
+
+   CONTENTS (grep for the anchors; the implementation repeats them in the same order)
+       >>config        options, sph_real
+       >>types         sph_status
+       >>kernels       sph_kernel: W, dW/dr, grad W (usable on their own)
+       >>grid          sph_grid, sph_neighbors: cell grid and neighbour lists (on their own)
+       >>world         sph_world_def, sph_phase, sph_world: particles, walls, phases
+       >>boundaries    wall particles: Adami pressure extrapolation, no-slip
+       >>stages        the shared stages; sph_stable_dt, sph_step, sph_advance
+       >>wcsph         sph_step_wcsph
+       >>io            sph_write_csv, sph_write_vtk
+
+   COMPILE-TIME OPTIONS (define before including the implementation)
+       SPH_FLOAT          sph_real is float instead of double
+       SPH_STATIC         all functions static (a private copy in one translation unit)
+       SPH_MALLOC(size), SPH_REALLOC(ptr, size), SPH_FREE(ptr)
+                          the allocator (define all three or none; default libc)
+       SPH_ASSERT(cond)   internal invariants (default assert); never used for user input
+       SPH_VALIDATE       expensive self-checks (neighbour-list symmetry), for tests
+       SPH_MAX_PHASES     phases per world (default 16)
+   OpenMP is used when the compiler enables it (-fopenmp); otherwise everything runs serially.
+
+   QUICK START (examples/hello.c; the tests check that this text is that file):
+*/
+#if 0 /* QUICKSTART-BEGIN */
+#define SPH_IMPLEMENTATION
+#include "sph.h"
+#include <stdio.h>
+
+int main(void) {
+    sph_world_def def = sph_world_def_default(2); /* 2D, y up, gravity -9.81 m/s^2 */
+    def.spacing = 0.02;                           /* particle spacing [m]          */
+    sph_world w;
+    if (sph_world_init(&w, &def) != SPH_OK) { printf("%s\n", w.error); return 1; }
+    int water = sph_world_add_phase(&w, &(sph_phase){.rest_density = 1000});
+    sph_real lo[2] = {0, 0}, column[2] = {0.4, 0.8}, tank[2] = {2.0, 1.0};
+    sph_fill_box(&w, water, lo, column);   /* 0.4 m x 0.8 m of water              */
+    sph_add_wall_box(&w, lo, tank, 0, 0);  /* closed tank, walls as deep as needed */
+    for (int frame = 1; frame <= 20; ++frame) {
+        if (sph_advance(&w, 0.05) != SPH_OK) { printf("error: %s\n", w.error); break; }
+        double front = 0;
+        for (size_t i = 0; i < w.n; ++i)
+            if (w.x[i * 2] > front) front = w.x[i * 2];
+        printf("t = %.2f s  steps %5llu  front at x = %.3f m  max speed %.2f m/s\n", w.time,
+               (unsigned long long)w.steps, front, w.stats.v_max);
+    }
+    sph_world_free(&w);
+    return 0;
+}
+#endif /* QUICKSTART-END */
+/*
+   UNITS AND SCALES
+   SI throughout: m, s, kg, Pa. A world has a dimension (1, 2 or 3) fixed at init; vectors are
+   stored with stride dim (x[i*dim + k]), so a 2D world stores no third component. y is up:
+   the default gravity is (0, -9.81) in 2D and (0, -9.81, 0) in 3D. The particle spacing dx sets
+   the resolution and, with h_factor, the smoothing length h = h_factor * dx; the kernel support
+   is 2h or 3h. A particle of phase q has mass rest_density * dx^dim unless set otherwise.
+
+   KERNELS
+   sph_kernel_init(&k, type, dim, h) then sph_kernel_w / _dwdr / _grad. Wendland C2 (default,
+   h = 1.3 dx, 21 neighbours in 2D), cubic and quintic B-splines, Wendland C4/C6, and a Gaussian
+   truncated at 3h (shifted to vanish there and renormalised, so it integrates to exactly one;
+   its slope still jumps by 7e-4 of its peak at 3h). All are normalised in 1D, 2D and 3D; W and
+   its derivatives are exactly zero from the support radius on. Discrete sums are not exact: on
+   a square lattice with Wendland C2 at h = 1.3 dx the pressure gradient is reproduced to 0.974
+   and Morris' Laplacian to 0.963 (a larger h_factor improves both at more neighbours).
+
+   NEIGHBOUR GRID
+   sph_grid sorts points into cells of the support radius with a counting sort. Cells are
+   addressed through a dense table over the points' bounding box when that is small, otherwise
+   through a hash table, so one particle far away costs no memory. Periodic directions wrap.
+   sph_neighbors stores compressed lists (begin/count/idx) filled in parallel chunks; memory is
+   reused between builds and grows only when a chunk needs more room.
+
+   THE WORLD
+   sph_world_def_default(dim) gives physical defaults; change fields, then sph_world_init, which
+   rejects an invalid field with SPH_ERR_ARG and a message naming it. Add phases (materials) with
+   sph_world_add_phase, fluid with sph_fill_box / sph_add_fluid, walls with sph_add_wall_box /
+   sph_add_boundary. The world is a caller-owned struct: read n, x, v, rho, p, id, phase, and
+   nb, b_x, b_v, b_p ... directly; positions and velocities may be written between steps.
+   Particles are reordered by cell at every step: follow one by its id, not by its index. Array
+   pointers change only when particles are added. A per-particle mass array (w.m) exists only
+   when particles of different mass coexist; otherwise every particle has mass w.mass.
+
+   SOLVER: WCSPH (sph_step_wcsph, or sph_step / sph_advance with def.solver)
+   Pressure from a stiff equation of state per phase: Tait, p = B((rho/rho0)^gamma - 1) with
+   B = rho0 c0^2 / gamma and gamma = 7, or linear, p = c0^2 (rho - rho0). A sound speed of 0
+   asks for c0 = 10 max(sqrt(2 |g| H), |v|max), chosen at the first step, so density varies by
+   about 1 %. Density by continuity (default) with delta-SPH diffusion (Molteni & Colagrossi
+   2009, delta = 0.1), by summation (negative pressures then clamped), or by Ott & Schnetter's
+   particle-density continuity for phases of very different density. Viscosity: Monaghan's
+   artificial viscosity (alpha = 0.02 by default) and a laminar viscosity per phase (Morris et al.
+   1997 by default, or the 2(d+2) form of seed 000). Time integration: symplectic Euler (default)
+   or Stormer-Verlet (second order in time); both take two neighbour passes per step over one
+   neighbour list (forces, then the density rate with the new velocities, which stable
+   integration of the acoustic waves requires). sph_stable_dt combines the acoustic CFL
+   (0.25 h / (c0 + |v|)), the viscous limit (0.125 h^2 / nu) and the force limit
+   (0.25 sqrt(h / |a|)); sph_advance(&w, duration) steps with it, landing exactly on the end.
+
+   BOUNDARIES
+   Walls are layers of boundary particles with a volume each (sph_add_wall_box makes enough
+   layers to cover the support). Their pressure is extrapolated from the fluid (Adami, Hu &
+   Adams 2012, eq. 27) including the body force and the wall's own acceleration, their density
+   follows from the equation of state; a wall acts on a fluid particle like fluid of that
+   particle's own rest density. Free slip (default) leaves walls out of the viscous terms;
+   no-slip uses Adami's extrapolated wall velocity. Boundary particles can move: see callbacks.
+
+   CALLBACKS AND THREADS
+   def.force: adds body accelerations for a range of fluid particles; called from worker threads
+   with disjoint ranges once per step, before the pressure and viscous forces; the wall pressure
+   sees these accelerations like gravity. def.boundary_motion: called once per step on the
+   calling thread before the neighbour search with the time of the force evaluation; sets b_x,
+   b_v (and b_a, the wall acceleration) of moving boundary particles; b_x0 keeps each particle's
+   reference position and b_body the tag given when it was added. Loops over particles are
+   OpenMP parallel and gather-only (each particle writes only its own values); small worlds run
+   on one thread.
+
+   MEMORY
+   All allocation goes through SPH_MALLOC/SPH_REALLOC/SPH_FREE. Arrays grow when particles are
+   added; scratch and neighbour lists grow when the neighbour count grows and are reused, so a
+   step allocates nothing in the steady state. Optional arrays (per-particle mass, Verlet
+   scratch) exist only when used. sph_world_free releases everything the world allocated.
+
+   ERRORS
+   Functions that can fail return sph_status; w.error holds a message with the detail (field,
+   particle index and id, value) and w.error_index the particle. Bad input (an invalid def field
+   or phase, non-finite positions or velocities, dt <= 0, a bad phase index) is rejected before
+   anything changes. A blow-up (a non-finite value, density <= 0, compression beyond
+   def.max_compression, a speed beyond def.max_speed or the largest c0) is reported as
+   SPH_ERR_UNSTABLE at the step where it happens, naming the first offending particle. The
+   library never calls exit or abort on user input and never drops particles: particles leaving
+   def.domain are counted in w.stats.n_outside and kept.
+
+   DETERMINISM
+   Reductions combine fixed blocks of particles in a fixed order and every loop is a gather, so
+   results are bitwise identical for any number of threads (tests compare 1 and 2 threads).
+
+   DIAGNOSTICS
+   After each step w.stats holds dt, iterations, mean and max |rho/rho0 - 1|, max speed and
+   acceleration, kinetic energy, fluid neighbour pairs, particles outside the domain and the
+   wall-clock time per stage; w.step_time_total and w.stage_time_total accumulate them.
+
+   WHAT IT DOES NOT DO (yet)
+   Only the WCSPH solver is in this version; PCISPH, IISPH and the explicit compressible
+   multiphase step are planned. No surface tension, no turbulence model, no rigid-body coupling
+   (boundaries move kinematically), no adaptive resolution, no GPU.
 */
 /* ============================================================================================== */
 /* >>config                                                                                       */
@@ -123,7 +279,7 @@ typedef struct sph_grid {
     size_t nbucket;
     int hashed;           /* 0: dense bounding-box table, 1: hash table                       */
     /* private */
-    sph_real inv[3];      /* 1 / cell edge per direction (periodic directions divide len)     */
+    double inv[3];        /* 1 / cell edge per direction, slightly shrunk (see sph_grid_init)  */
     int32_t ncell[3];     /* cells along periodic directions                                  */
     int64_t cmin[3], ext[3];
     uint32_t* bucket;     /* [n] scratch: bucket of each point                                */
@@ -192,6 +348,13 @@ typedef enum sph_integrator {
     SPH_INTEGRATOR_VERLET                /* Stormer-Verlet drift-kick-drift, second order       */
 } sph_integrator;
 
+typedef enum sph_viscosity_form {
+    SPH_VISC_MORRIS = 0, /* Morris et al. 1997: sum_j m_j (mu_i + mu_j) x_ij.grad W_ij /
+                            (rho_i rho_j (r^2 + eta^2)) v_ij; accurate Laplacian (default)      */
+    SPH_VISC_MONAGHAN    /* Monaghan 2005 / seed 000 eq. 2.5: 2(d+2) ... (v_ij.x_ij) grad W_ij;
+                            conserves angular momentum, less accurate on a lattice            */
+} sph_viscosity_form;
+
 typedef enum sph_wall {
     SPH_WALL_FREE_SLIP = 0, /* no viscous interaction with wall particles (default)             */
     SPH_WALL_NO_SLIP        /* viscous terms use Adami's extrapolated wall velocity             */
@@ -227,10 +390,11 @@ typedef enum sph_stage {
 
 struct sph_world;
 
-/* Adds accelerations [m/s^2] of fluid particles begin..end-1 to acc[i*dim + k]. Called from
-   worker threads with disjoint ranges while a step runs; it may read the world (positions,
-   velocities, densities, pressures are those the step's forces use) and must write only
-   acc[i*dim + k] for i in its range. */
+/* Adds body accelerations [m/s^2] of fluid particles begin..end-1 to acc[i*dim + k] (which holds
+   gravity when it is called). Called once per step from worker threads with disjoint ranges,
+   after the step's densities and pressures are known and before the pressure and viscous forces;
+   it may read the world and must write only acc[i*dim + k] for i in its range. The wall pressure
+   extrapolation sees these accelerations like gravity. */
 typedef void (*sph_force_fn)(const struct sph_world* w, size_t begin, size_t end, sph_real* acc,
                              void* user);
 
@@ -256,6 +420,7 @@ typedef struct sph_world_def {
     sph_real delta;            /* delta-SPH density diffusion coefficient; default 0.1; [0, 1]    */
     sph_real alpha;            /* Monaghan artificial viscosity alpha; default 0.02; [0, 10]      */
     sph_real beta;             /* Monaghan artificial viscosity beta; default 0; [0, 10]          */
+    sph_viscosity_form viscosity_form; /* laminar viscosity operator; default SPH_VISC_MORRIS    */
     sph_wall wall;             /* default SPH_WALL_FREE_SLIP                                      */
     sph_real cfl;              /* acoustic CFL number for sph_stable_dt; default 0.25; (0, 1]     */
     sph_real cfl_viscous;      /* viscous limit dt <= cfl_viscous h^2 / nu; default 0.125         */
@@ -305,14 +470,12 @@ typedef struct sph__private {
     sph_neighbors ff, fb, bf;       /* fluid->fluid, fluid->boundary, boundary->fluid              */
     uint8_t* perm_buf;              /* permutation scratch, capacity * largest element              */
     size_t perm_cap;                /* bytes                                                        */
-    uint32_t* b_order;              /* boundary order scratch                                       */
     double* block;                  /* per-block partial reductions                                 */
     size_t block_cap;
     sph_real* rho_n;                /* Verlet: density at the start of the step (scratch)          */
     size_t rho_n_cap;
     int b_dirty;                    /* boundary particles changed since the last boundary grid     */
-    sph_real mass;                  /* mass of every particle while w->m is NULL                   */
-    int have_mass;
+    int have_mass;                  /* w->mass is set                                               */
 } sph__private;
 
 /* The world: a caller-owned plain struct. Read the arrays directly; positions and velocities may
@@ -328,6 +491,8 @@ typedef struct sph_world {
     int nphase;
     double time;               /* simulated time [s]                                               */
     uint64_t steps;            /* steps taken                                                      */
+    double step_time_total;    /* wall-clock seconds spent in steps since init                     */
+    double stage_time_total[SPH_STAGE_COUNT]; /* the same per stage                               */
 
     /* fluid particles, i = 0 .. n-1 */
     size_t n, capacity;
@@ -335,7 +500,8 @@ typedef struct sph_world {
     sph_real* v;               /* [n*dim] velocity [m/s]                                           */
     sph_real* rho;             /* [n] density [kg/m^3]                                             */
     sph_real* p;               /* [n] pressure [Pa]                                                */
-    sph_real* m;               /* [n] mass [kg]; NULL while every particle of a phase has its mass  */
+    sph_real* m;               /* [n] mass [kg]; NULL while all particles have the same mass       */
+    sph_real mass;             /* the mass of every fluid particle while m is NULL [kg]            */
     uint32_t* id;              /* [n] stable identity                                              */
     uint8_t* phase;            /* [n] phase index                                                  */
     sph_real* a;               /* [n*dim] acceleration of the last step [m/s^2] (scratch)          */
@@ -388,6 +554,9 @@ SPHDEF sph_status sph_add_boundary(sph_world* w, size_t n, const sph_real* x, co
 SPHDEF sph_status sph_set_hydrostatic(sph_world* w);
 /* The message of the last error (empty if none). */
 SPHDEF const char* sph_world_error(const sph_world* w);
+/* Bytes the world has allocated: particle arrays (at their capacity), grids, neighbour lists
+   and scratch. */
+SPHDEF size_t sph_world_memory(const sph_world* w);
 /* Total fluid mass [kg] and linear momentum [kg m/s] (out[dim]). */
 SPHDEF double sph_world_mass(const sph_world* w);
 SPHDEF void sph_world_momentum(const sph_world* w, double* out);
@@ -455,11 +624,13 @@ SPHDEF sph_status sph_write_vtk(const sph_world* w, const char* path);
 #if defined(_OPENMP)
 #include <omp.h>
 #define SPH__PRAGMA(x) _Pragma(#x)
-#define SPH__OMP_FOR SPH__PRAGMA(omp parallel for schedule(static))
-#define SPH__OMP_FOR_DYNAMIC SPH__PRAGMA(omp parallel for schedule(dynamic, 1))
+/* Loops over `count` items run in parallel only when there is enough work to pay for a team:
+   tiny worlds (a few hundred particles) are faster on one thread. */
+#define SPH__OMP_FOR(count) SPH__PRAGMA(omp parallel for schedule(static) if ((count) > 2048))
+#define SPH__OMP_FOR_DYNAMIC(count) SPH__PRAGMA(omp parallel for schedule(dynamic, 1) if ((count) > 8))
 #else
-#define SPH__OMP_FOR
-#define SPH__OMP_FOR_DYNAMIC
+#define SPH__OMP_FOR(count)
+#define SPH__OMP_FOR_DYNAMIC(count)
 #endif
 
 #if defined(_WIN32)
@@ -726,21 +897,26 @@ SPHDEF sph_status sph_kernel_init(sph_kernel* k, sph_kernel_type type, int dim, 
     return SPH_OK;
 }
 
+/* r * inv_h can round to just below the support factor at r = radius: the explicit cut makes
+   W and its derivatives exactly zero from the radius on. */
 SPHDEF sph_real sph_kernel_w(const sph_kernel* k, sph_real r) {
-    return k->norm_w * sph__kw(k->form, sph__fabs(r) * k->inv_h);
+    r = sph__fabs(r);
+    if (r >= k->radius) return 0;
+    return k->norm_w * sph__kw(k->form, r * k->inv_h);
 }
 
 SPHDEF sph_real sph_kernel_dwdr(const sph_kernel* k, sph_real r) {
-    sph_real q = sph__fabs(r) * k->inv_h;
+    r = sph__fabs(r);
+    if (r >= k->radius) return 0;
     /* dW/dr = norm_g * f(q) * r  (since f = w'/q and norm_g = norm_w / h^2) */
-    return k->norm_g * sph__kf(k->form, q) * sph__fabs(r);
+    return k->norm_g * sph__kf(k->form, r * k->inv_h) * r;
 }
 
 SPHDEF void sph_kernel_grad(const sph_kernel* k, const sph_real* xij, sph_real* grad) {
-    sph_real r2 = 0, s;
+    sph_real r2 = 0, s = 0;
     int d;
     for (d = 0; d < k->dim; ++d) r2 += xij[d] * xij[d];
-    s = k->norm_g * sph__kf(k->form, sph__sqrt(r2) * k->inv_h);
+    if (r2 < k->radius * k->radius) s = k->norm_g * sph__kf(k->form, sph__sqrt(r2) * k->inv_h);
     for (d = 0; d < k->dim; ++d) grad[d] = s * xij[d];
 }
 
@@ -757,14 +933,14 @@ SPH__INLINE int32_t sph__cell_coord(const sph_grid* g, int k, sph_real xk) {
     double t;
     if (g->periodic[k]) {
         long long c;
-        t = floor((double)(xk - g->lo[k]) * (double)g->inv[k]);
+        t = floor((double)(xk - g->lo[k]) * g->inv[k]);
         if (!(t > -1e15)) t = 0; /* NaN or absurd: any cell; the distance test decides */
         if (t > 1e15) t = 0;
         c = (long long)t % (long long)g->ncell[k];
         if (c < 0) c += g->ncell[k];
         return (int32_t)c;
     }
-    t = floor((double)xk * (double)g->inv[k]);
+    t = floor((double)xk * g->inv[k]);
     if (!(t >= -SPH__CELL_LIM)) t = -SPH__CELL_LIM; /* also catches NaN */
     if (t > SPH__CELL_LIM - 1) t = SPH__CELL_LIM - 1;
     return (int32_t)t;
@@ -822,8 +998,11 @@ SPHDEF sph_status sph_grid_init(sph_grid* g, int dim, sph_real cell_size, const 
         return SPH_ERR_ARG;
     g->dim = dim;
     g->cell = cell_size;
+    /* Cells are 2^-30 wider than asked: below the 2^20-cell clamp the rounding of x * inv is
+       under 2^-32 cells, so two points closer than the cell size can never land two cells
+       apart (with cells of exactly the radius, 1/cell rounding up could split such a pair). */
     for (k = 0; k < 3; ++k) {
-        g->inv[k] = 1 / cell_size;
+        g->inv[k] = (1.0 - 1.0 / 1073741824.0) / (double)cell_size;
         if (k < dim && periodic && periodic[k]) {
             sph_real len;
             if (!lo || !hi || !sph__finite((double)lo[k]) || !sph__finite((double)hi[k]))
@@ -835,7 +1014,7 @@ SPHDEF sph_status sph_grid_init(sph_grid* g, int dim, sph_real cell_size, const 
             g->len[k] = len;
             g->ncell[k] = (int32_t)floor((double)len / (double)cell_size);
             if (g->ncell[k] > SPH__CELL_LIM) g->ncell[k] = SPH__CELL_LIM;
-            g->inv[k] = (sph_real)g->ncell[k] / len;
+            g->inv[k] = (1.0 - 1.0 / 1073741824.0) * (double)g->ncell[k] / (double)len;
         }
     }
     return SPH_OK;
@@ -898,7 +1077,7 @@ SPHDEF sph_status sph_grid_build(sph_grid* g, const sph_real* x, size_t n) {
     g->hashed = hashed;
     g->nbucket = nbucket;
     g->n = n;
-    SPH__OMP_FOR
+    SPH__OMP_FOR(n)
     for (i = 0; i < (sph__idx)n; ++i) {
         int32_t c[3] = {0, 0, 0};
         int kk;
@@ -917,7 +1096,7 @@ SPHDEF sph_status sph_grid_build(sph_grid* g, const sph_real* x, size_t n) {
     g->start[0] = 0;
     /* hash mode: cells of the sorted points, to tell apart cells that share a bucket */
     if (hashed) {
-        SPH__OMP_FOR
+        SPH__OMP_FOR(n)
         for (i = 0; i < (sph__idx)n; ++i) {
             int32_t c[3] = {0, 0, 0};
             int kk;
@@ -1018,6 +1197,59 @@ static size_t sph__neighbors_chunk(sph_neighbors* nl, const sph_grid* g, const s
     return pos - nl->chunk_off[c];
 }
 
+/* The common case, specialised per dimension: a dense table, no periodic direction, points
+   stored in cell order. The three cells along x of a row of the stencil are consecutive buckets,
+   so each row is one contiguous range of points (3 ranges in 2D, 9 in 3D instead of 9 and 27
+   cells). */
+SPH__INLINE size_t sph__neighbors_chunk_dense(sph_neighbors* nl, const sph_grid* g,
+                                              const sph_real* x, const sph_real* xq, size_t nq,
+                                              sph_real radius, int exclude_self, size_t c,
+                                              const int D) {
+    const sph_real r2max = radius * radius;
+    const int64_t ex0 = g->ext[0], ex1 = D > 1 ? g->ext[1] : 1, ex2 = D > 2 ? g->ext[2] : 1;
+    size_t i, i0 = c * SPH__CHUNK, i1 = i0 + SPH__CHUNK;
+    size_t pos = nl->chunk_off[c], end = pos + nl->chunk_cap[c];
+    if (i1 > nq) i1 = nq;
+    for (i = i0; i < i1; ++i) {
+        const sph_real* p = xq + i * (size_t)D;
+        int64_t cc[3] = {0, 0, 0}, xa, xb, dy, dz;
+        const size_t b0 = pos;
+        int k;
+        for (k = 0; k < D; ++k) cc[k] = (int64_t)sph__cell_coord(g, k, p[k]) - g->cmin[k];
+        xa = cc[0] > 0 ? cc[0] - 1 : 0;
+        xb = cc[0] + 1 < ex0 ? cc[0] + 1 : ex0 - 1;
+        if (xa <= xb) {
+            for (dz = (D > 2 ? -1 : 0); dz <= (D > 2 ? 1 : 0); ++dz) {
+                const int64_t z = cc[2] + dz;
+                if (z < 0 || z >= ex2) continue;
+                for (dy = (D > 1 ? -1 : 0); dy <= (D > 1 ? 1 : 0); ++dy) {
+                    const int64_t y = cc[1] + dy;
+                    size_t q, qe;
+                    int64_t row;
+                    if (y < 0 || y >= ex1) continue;
+                    row = (z * ex1 + y) * ex0;
+                    q = g->start[row + xa];
+                    qe = g->start[row + xb + 1];
+                    for (; q < qe; ++q) {
+                        const sph_real* xj = x + q * (size_t)D;
+                        sph_real r2 = 0, dd;
+                        dd = p[0] - xj[0]; r2 += dd * dd;
+                        if (D > 1) { dd = p[1] - xj[1]; r2 += dd * dd; }
+                        if (D > 2) { dd = p[2] - xj[2]; r2 += dd * dd; }
+                        if (r2 < r2max && !(exclude_self && q == i)) {
+                            if (pos < end) nl->idx[pos] = (uint32_t)q;
+                            ++pos;
+                        }
+                    }
+                }
+            }
+        }
+        nl->begin[i] = b0;
+        nl->count[i] = (uint32_t)(pos - b0);
+    }
+    return pos - nl->chunk_off[c];
+}
+
 static sph_status sph__neighbors_build(sph_neighbors* nl, const sph_grid* g, const sph_real* x,
                                        const uint32_t* order, const sph_real* xq, size_t nq,
                                        sph_real radius, int exclude_self) {
@@ -1051,10 +1283,21 @@ static sph_status sph__neighbors_build(sph_neighbors* nl, const sph_grid* g, con
             if (!sph__grow((void**)&nl->idx, total_cap, sizeof(uint32_t))) return SPH_ERR_NOMEM;
             nl->cap_idx = total_cap;
         }
-        SPH__OMP_FOR_DYNAMIC
-        for (ci = 0; ci < (sph__idx)nchunk; ++ci)
-            nl->chunk_need[ci] = sph__neighbors_chunk(nl, g, x, order, xq, nq, radius,
-                                                      exclude_self, (size_t)ci);
+        const int fast = !order && !g->hashed && !g->periodic[0] && !g->periodic[1] &&
+                         !g->periodic[2] && g->n > 0;
+        SPH__OMP_FOR_DYNAMIC(nchunk)
+        for (ci = 0; ci < (sph__idx)nchunk; ++ci) {
+            size_t need;
+            if (fast && g->dim == 2)
+                need = sph__neighbors_chunk_dense(nl, g, x, xq, nq, radius, exclude_self, (size_t)ci, 2);
+            else if (fast && g->dim == 3)
+                need = sph__neighbors_chunk_dense(nl, g, x, xq, nq, radius, exclude_self, (size_t)ci, 3);
+            else if (fast)
+                need = sph__neighbors_chunk_dense(nl, g, x, xq, nq, radius, exclude_self, (size_t)ci, 1);
+            else
+                need = sph__neighbors_chunk(nl, g, x, order, xq, nq, radius, exclude_self, (size_t)ci);
+            nl->chunk_need[ci] = need;
+        }
         for (c = 0; c < nchunk; ++c) {
             if (nl->chunk_need[c] > nl->chunk_cap[c]) {
                 overflow = 1;
@@ -1109,7 +1352,7 @@ SPHDEF sph_world_def sph_world_def_default(int dim) {
     d.beta = 0;
     d.wall = SPH_WALL_FREE_SLIP;
     d.cfl = SPH__R(0.25);
-    d.cfl_viscous = SPH__R(0.125);
+    d.cfl_viscous = SPH__R(0.125); /* Morris et al. 1997; see sph_stable_dt for the margins */
     d.cfl_force = SPH__R(0.25);
     d.max_compression = SPH__R(0.2);
     d.max_speed = 0;
@@ -1143,6 +1386,8 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
                "sph_world_def.integrator = %d: not a sph_integrator", (int)d->integrator);
     SPH__CHECK((int)d->clamp >= 0 && d->clamp <= SPH_CLAMP_OFF,
                "sph_world_def.clamp = %d: not a sph_pressure_clamp", (int)d->clamp);
+    SPH__CHECK((int)d->viscosity_form >= 0 && d->viscosity_form <= SPH_VISC_MONAGHAN,
+               "sph_world_def.viscosity_form = %d: not a sph_viscosity_form", (int)d->viscosity_form);
     SPH__CHECK((int)d->wall >= 0 && d->wall <= SPH_WALL_NO_SLIP,
                "sph_world_def.wall = %d: not a sph_wall", (int)d->wall);
     SPH__CHECK(sph__finite((double)d->delta) && d->delta >= 0 && d->delta <= 1,
@@ -1224,7 +1469,6 @@ SPHDEF void sph_world_free(sph_world* w) {
     sph_neighbors_free(&w->priv.fb);
     sph_neighbors_free(&w->priv.bf);
     SPH_FREE(w->priv.perm_buf);
-    SPH_FREE(w->priv.b_order);
     SPH_FREE(w->priv.block);
     SPH_FREE(w->priv.rho_n);
     memset(w, 0, sizeof(*w));
@@ -1353,14 +1597,14 @@ static sph_status sph__append_fluid(sph_world* w, int phase, size_t n, const sph
     const size_t dim = (size_t)w->dim;
     size_t i, base = w->n;
     sph_status s;
-    int need_m = w->m == NULL && w->priv.have_mass && mass != w->priv.mass;
+    int need_m = w->m == NULL && w->priv.have_mass && mass != w->mass;
     s = sph__reserve(w, 0, w->n + n);
     if (s != SPH_OK) return s;
     if (need_m) { /* particles of different masses: keep a mass per particle from now on */
         sph_real* m = NULL;
         if (!sph__grow((void**)&m, w->capacity, sizeof(sph_real)))
             return sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory for the mass array");
-        for (i = 0; i < w->n; ++i) m[i] = w->priv.mass;
+        for (i = 0; i < w->n; ++i) m[i] = w->mass;
         w->m = m;
     }
     for (i = 0; i < n; ++i) {
@@ -1377,7 +1621,7 @@ static sph_status sph__append_fluid(sph_world* w, int phase, size_t n, const sph
         w->phase[j] = (uint8_t)phase;
         if (w->m) w->m[j] = mass;
     }
-    if (!w->priv.have_mass) { w->priv.have_mass = 1; w->priv.mass = mass; }
+    if (!w->priv.have_mass) { w->priv.have_mass = 1; w->mass = mass; }
     w->n += n;
     return SPH_OK;
 }
@@ -1594,11 +1838,37 @@ done:
     return s;
 }
 
+static size_t sph__grid_memory(const sph_grid* g) {
+    return g->cap_n * (2 * sizeof(uint32_t) + sizeof(uint64_t)) + g->cap_bucket * sizeof(uint32_t);
+}
+
+static size_t sph__neighbors_memory(const sph_neighbors* nl) {
+    return nl->cap_n * (sizeof(size_t) + sizeof(uint32_t)) + nl->cap_idx * sizeof(uint32_t) +
+           nl->cap_chunk * 4 * sizeof(size_t);
+}
+
+SPHDEF size_t sph_world_memory(const sph_world* w) {
+    sph__array arr[16];
+    size_t bytes = 0;
+    int k, n;
+    if (!w) return 0;
+    n = sph__fluid_arrays((sph_world*)w, arr);
+    for (k = 0; k < n; ++k) bytes += w->capacity * arr[k].elem;
+    n = sph__boundary_arrays((sph_world*)w, arr);
+    for (k = 0; k < n; ++k) bytes += w->b_capacity * arr[k].elem;
+    bytes += sph__grid_memory(&w->priv.grid) + sph__grid_memory(&w->priv.bgrid);
+    bytes += sph__neighbors_memory(&w->priv.ff) + sph__neighbors_memory(&w->priv.fb) +
+             sph__neighbors_memory(&w->priv.bf);
+    bytes += w->priv.perm_cap + w->priv.block_cap * sizeof(double) +
+             w->priv.rho_n_cap * sizeof(sph_real);
+    return bytes;
+}
+
 SPHDEF double sph_world_mass(const sph_world* w) {
     double sum = 0;
     size_t i;
     if (!w) return 0;
-    for (i = 0; i < w->n; ++i) sum += (double)(w->m ? w->m[i] : w->priv.mass);
+    for (i = 0; i < w->n; ++i) sum += (double)(w->m ? w->m[i] : w->mass);
     return sum;
 }
 
@@ -1608,7 +1878,7 @@ SPHDEF void sph_world_momentum(const sph_world* w, double* out) {
     if (!w || !out) return;
     for (k = 0; k < w->dim; ++k) out[k] = 0;
     for (i = 0; i < w->n; ++i) {
-        double mi = (double)(w->m ? w->m[i] : w->priv.mass);
+        double mi = (double)(w->m ? w->m[i] : w->mass);
         for (k = 0; k < w->dim; ++k) out[k] += mi * (double)w->v[i * (size_t)w->dim + (size_t)k];
     }
 }
@@ -1664,7 +1934,7 @@ typedef struct sph__ctx {
     const sph_real *bx, *bv, *bvw, *bvol, *bp, *brho;
     sph__phase_c pc[SPH_MAX_PHASES];
     const sph_neighbors *ff, *fb, *bf;
-    int density, pgrad, noslip, laminar, av, delta_on;
+    int density, pgrad, noslip, laminar, morris, av, delta_on;
     sph_real alpha, beta, delta, visc_k;
     sph_real g[3];
 } sph__ctx;
@@ -1684,7 +1954,7 @@ static void sph__ctx_init(sph_world* w, sph__ctx* c) {
     c->h = w->h;
     c->eta2 = SPH__R(0.01) * w->h * w->h;
     c->x = w->x; c->v = w->v; c->rho = w->rho; c->p = w->p; c->m = w->m;
-    c->m0 = w->priv.mass;
+    c->m0 = w->mass;
     c->ph = w->phase;
     c->bx = w->b_x; c->bv = w->b_v; c->bvw = w->b_vw; c->bvol = w->b_vol;
     c->bp = w->b_p; c->brho = w->b_rho;
@@ -1710,6 +1980,7 @@ static void sph__ctx_init(sph_world* w, sph__ctx* c) {
     c->density = (int)w->def.density;
     c->pgrad = (int)w->def.pressure_grad;
     c->noslip = w->def.wall == SPH_WALL_NO_SLIP;
+    c->morris = w->def.viscosity_form == SPH_VISC_MORRIS;
     c->alpha = w->def.alpha;
     c->beta = w->def.beta;
     c->av = w->def.alpha > 0 || w->def.beta > 0;
@@ -1718,6 +1989,7 @@ static void sph__ctx_init(sph_world* w, sph__ctx* c) {
     /* Monaghan 2005 / seed 000 sec. 2.2.2: nu Lap v = 2(d+2) sum_j m_j nu_bar/rho_bar ...; with
        (mu_i + mu_j)/(rho_i rho_j) the factor 2 of the average moves into visc_k = d + 2. */
     c->visc_k = (sph_real)(w->dim + 2);
+    if (c->morris) c->visc_k = 1;
 }
 
 SPH__INLINE void sph__delta_vec(const sph__ctx* c, const sph_real* a, const sph_real* b,
@@ -1732,17 +2004,20 @@ SPH__INLINE void sph__delta_vec(const sph__ctx* c, const sph_real* a, const sph_
 /* Adami, Hu & Adams 2012, eq. 27: the pressure of wall particle b extrapolated from its fluid
    neighbours f, with the wall's acceleration a_b (moving walls):
        p_b = (sum_f p_f W_bf + (g - a_b) . sum_f rho_f x_bf W_bf) / sum_f W_bf,  x_bf = x_b - x_f.
+   g is the body acceleration of the fluid: gravity plus the user force callback, taken per fluid
+   particle (w->a holds it when this stage runs), so a force field that replaces gravity gives
+   the same walls as gravity.
    The wall density follows from each neighbouring phase's equation of state (Adami eq. 28),
    stored relative to rest as b_rho[b] = sum_f W_bf (rho/rho0)_f(p_b) / sum_f W_bf.
    No-slip (Adami eqs. 22-23): the viscous terms see v~_b = 2 v_b - sum_f v_f W_bf / sum_f W_bf. */
 static void sph__stage_wall_pressure(sph_world* w, const sph__ctx* c) {
     const int D = c->dim;
     sph__idx b;
-    SPH__OMP_FOR
+    SPH__OMP_FOR(w->nb)
     for (b = 0; b < (sph__idx)w->nb; ++b) {
         const sph_neighbors* nl = c->bf;
         const sph_real* xb = c->bx + (size_t)b * (size_t)D;
-        sph_real sw = 0, swp = 0, srx[3] = {0, 0, 0}, sv[3] = {0, 0, 0}, wph[SPH_MAX_PHASES];
+        sph_real sw = 0, swp = 0, sgx = 0, sv[3] = {0, 0, 0}, wph[SPH_MAX_PHASES];
         size_t kk, k0 = nl->begin[b], k1 = k0 + nl->count[b];
         int k, q;
         for (q = 0; q < c->nphase; ++q) wph[q] = 0;
@@ -1754,16 +2029,15 @@ static void sph__stage_wall_pressure(sph_world* w, const sph__ctx* c) {
             W = sph__kw(c->k.form, sph__sqrt(r2) * c->k.inv_h);
             sw += W;
             swp += c->p[f] * W;
-            for (k = 0; k < D; ++k) {
-                srx[k] += c->rho[f] * d[k] * W;
+            for (k = 0; k < D; ++k) { /* rho_f (g_f - a_b) . x_bf W_bf */
+                sgx += c->rho[f] * (w->a[f * (size_t)D + (size_t)k] -
+                                    w->b_a[(size_t)b * (size_t)D + (size_t)k]) * d[k] * W;
                 sv[k] += c->v[f * (size_t)D + (size_t)k] * W;
             }
             wph[c->ph[f]] += W;
         }
         if (sw > 0) {
-            sph_real pb = swp, kap = 0;
-            for (k = 0; k < D; ++k) pb += (c->g[k] - w->b_a[(size_t)b * (size_t)D + (size_t)k]) * srx[k];
-            pb /= sw;
+            sph_real pb = (swp + sgx) / sw, kap = 0;
             for (q = 0; q < c->nphase; ++q)
                 if (wph[q] > 0) kap += wph[q] * sph__eos_inverse(&c->pc[q], pb);
             w->b_p[b] = pb;
@@ -1942,7 +2216,7 @@ static void sph__permute(sph_world* w, const sph__array* arr, int narr, const ui
         if (!arr[a].persistent) continue;
         /* fixed-size copies for the common element sizes */
 #define SPH__GATHER(SZ)                                                                            \
-    SPH__OMP_FOR for (i = 0; i < (sph__idx)n; ++i)                                                 \
+    SPH__OMP_FOR(n) for (i = 0; i < (sph__idx)n; ++i)                                              \
         memcpy(dst + (size_t)i * (SZ), src + (size_t)order[i] * (SZ), (SZ))
         switch (e) {
         case 1: SPH__GATHER(1); break;
@@ -1985,7 +2259,8 @@ static sph_status sph__stage_neighbors(sph_world* w) {
     if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour lists: %s", sph_status_string(s));
     w->stats.pairs = w->priv.ff.total;
 #ifdef SPH_VALIDATE
-    { /* every fluid pair is listed from both sides, and every listed pair is within the support */
+    { /* every fluid pair is listed from both sides; and now and then (small worlds) the lists
+         hold exactly the pairs a brute-force search finds */
         size_t i, kk, q;
         for (i = 0; i < w->n; ++i) {
             for (kk = w->priv.ff.begin[i]; kk < w->priv.ff.begin[i] + w->priv.ff.count[i]; ++kk) {
@@ -1993,6 +2268,29 @@ static sph_status sph__stage_neighbors(sph_world* w) {
                 for (q = w->priv.ff.begin[j]; q < w->priv.ff.begin[j] + w->priv.ff.count[j]; ++q)
                     if (w->priv.ff.idx[q] == i) found = 1;
                 SPH_ASSERT(found && j != i);
+            }
+        }
+        if (w->steps % 97 == 0 && w->n <= 5000 && w->nb <= 5000) {
+            for (i = 0; i < w->n; ++i) {
+                size_t nf = 0, nbd = 0;
+                for (q = 0; q < w->n; ++q) {
+                    sph_real d[3];
+                    int k;
+                    sph_real r2 = 0;
+                    sph_grid_delta(&w->priv.grid, w->x + i * (size_t)w->dim, w->x + q * (size_t)w->dim, d);
+                    for (k = 0; k < w->dim; ++k) r2 += d[k] * d[k];
+                    if (q != i && r2 < R * R) ++nf;
+                }
+                for (q = 0; q < w->nb; ++q) {
+                    sph_real d[3];
+                    int k;
+                    sph_real r2 = 0;
+                    sph_grid_delta(&w->priv.grid, w->x + i * (size_t)w->dim, w->b_x + q * (size_t)w->dim, d);
+                    for (k = 0; k < w->dim; ++k) r2 += d[k] * d[k];
+                    if (r2 < R * R) ++nbd;
+                }
+                SPH_ASSERT(nf == w->priv.ff.count[i]);
+                SPH_ASSERT(w->nb == 0 || nbd == w->priv.fb.count[i]);
             }
         }
     }
@@ -2006,7 +2304,7 @@ static void sph__stage_density_summation(sph_world* w, const sph__ctx* c) {
     const int D = c->dim;
     const sph_real w0 = c->k.norm_w * sph__kw(c->k.form, 0);
     sph__idx i;
-    SPH__OMP_FOR
+    SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) {
         const sph_real* xi = c->x + (size_t)i * (size_t)D;
         const sph_real mi = c->m ? c->m[i] : c->m0;
@@ -2039,7 +2337,7 @@ static void sph__stage_eos(sph_world* w, const sph__ctx* c) {
     const int clamp = w->def.clamp == SPH_CLAMP_ON ||
                       (w->def.clamp == SPH_CLAMP_AUTO && w->def.density == SPH_DENSITY_SUMMATION);
     sph__idx i;
-    SPH__OMP_FOR
+    SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) {
         const sph_real p = sph__eos(&c->pc[c->ph[i]], w->rho[i]);
         w->p[i] = clamp && p < 0 ? 0 : p;
@@ -2051,7 +2349,11 @@ enum { SPH__ACCEL = 1, SPH__RATE = 2 };
 /* The one neighbour loop for accelerations and the density rate of fluid particle i.
    ACCEL: pressure gradient (seed 000 sec. 2.2.1: sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W_ij,
           or the multiphase form (p_i + p_j)/(rho_i rho_j), Ott & Schnetter eq. 12), laminar
-          viscosity (Monaghan 2005: 2(d+2) sum_j m_j nu_bar/rho_bar v_ij.x_ij/(r^2+eta^2) grad W),
+          viscosity (Morris et al. 1997: sum_j m_j (mu_i + mu_j)/(rho_i rho_j) x_ij.grad W_ij/
+          (r^2+eta^2) v_ij, which needs only the second moment of grad W to give nu Lap v, 0.96 of
+          it on a lattice with Wendland C2 at h = 1.3 dx; or Monaghan 2005 / seed 000 eq. 2.5,
+          2(d+2) sum_j m_j nu_bar/rho_bar v_ij.x_ij/(r^2+eta^2) grad W, which conserves angular
+          momentum but needs the fourth moment: 0.80 of nu Lap v on the same lattice),
           Monaghan 1992 artificial viscosity
           Pi_ij = (-alpha c_bar mu_ij + beta mu_ij^2)/rho_bar, mu_ij = h v_ij.x_ij/(r^2+eta^2) when
           v_ij.x_ij < 0, gravity. [m/s^2]
@@ -2097,7 +2399,13 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
             sph_real s;
             if (c->pgrad == SPH_PGRAD_SYMMETRIC) s = -mj * (pi_r2 + pj / (rhoj * rhoj));
             else s = -mj * (pi + pj) * inv_rhoi / rhoj;
-            if (c->laminar) s += c->visc_k * mj * (P->mu + Pj->mu) * inv_rhoi / rhoj * vd / (r2 + c->eta2);
+            if (c->laminar) {
+                const sph_real lv = c->visc_k * mj * (P->mu + Pj->mu) * inv_rhoi / rhoj / (r2 + c->eta2);
+                if (c->morris) /* along v_ij: x_ij . grad W = fw r^2 */
+                    for (k = 0; k < D; ++k) ai[k] += lv * fw * r2 * (vi[k] - vj[k]);
+                else
+                    s += lv * vd;
+            }
             if (c->av && vd < 0) {
                 const sph_real mu = c->h * vd / (r2 + c->eta2);
                 const sph_real cbar = SPH__R(0.5) * (P->c0 + Pj->c0);
@@ -2134,7 +2442,14 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
                 if (c->noslip && (c->laminar || c->av)) {
                     sph_real vg = 0;
                     for (k = 0; k < D; ++k) vg += (vi[k] - c->bvw[b * (size_t)D + (size_t)k]) * d[k];
-                    if (c->laminar) s += c->visc_k * psi * 2 * P->mu * inv_rhoi / rhob * vg / (r2 + c->eta2);
+                    if (c->laminar) {
+                        const sph_real lv = c->visc_k * psi * 2 * P->mu * inv_rhoi / rhob / (r2 + c->eta2);
+                        if (c->morris)
+                            for (k = 0; k < D; ++k)
+                                ai[k] += lv * fw * r2 * (vi[k] - c->bvw[b * (size_t)D + (size_t)k]);
+                        else
+                            s += lv * vg;
+                    }
                     if (c->av && vg < 0) {
                         const sph_real mu = c->h * vg / (r2 + c->eta2);
                         s -= psi * (-c->alpha * P->c0 * mu + c->beta * mu * mu) * 2 / (rhoi + rhob);
@@ -2145,8 +2460,8 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
             }
         }
     }
-    if (flags & SPH__ACCEL)
-        for (k = 0; k < D; ++k) acc[i * (size_t)D + (size_t)k] = ai[k] + c->g[k];
+    if (flags & SPH__ACCEL) /* acc holds the body acceleration already */
+        for (k = 0; k < D; ++k) acc[i * (size_t)D + (size_t)k] += ai[k];
     if (flags & SPH__RATE) rate[i] = R;
 }
 
@@ -2155,7 +2470,7 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
 static void sph__stage_interact(sph_world* w, const sph__ctx* c, int flags) {
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
     sph__idx blk;
-    SPH__OMP_FOR
+    SPH__OMP_FOR(w->n) /* over blocks of SPH__BLOCK particles */
     for (blk = 0; blk < (sph__idx)nblk; ++blk) {
         const size_t i0 = (size_t)blk * SPH__BLOCK;
         const size_t i1 = i0 + SPH__BLOCK < w->n ? i0 + SPH__BLOCK : w->n;
@@ -2171,7 +2486,24 @@ static void sph__stage_interact(sph_world* w, const sph__ctx* c, int flags) {
         default: SPH_ASSERT(0); break;
         }
 #undef SPH__LOOP
-        if ((flags & SPH__ACCEL) && w->def.force) w->def.force(w, i0, i1, w->a, w->def.force_user);
+    }
+}
+
+/* Body accelerations: gravity plus the user's force callback, per block of particles. They start
+   the acceleration array; the wall extrapolation reads them, the neighbour pass adds to them. */
+static void sph__stage_body_force(sph_world* w, const sph__ctx* c) {
+    const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
+    const int D = c->dim;
+    sph__idx blk;
+    SPH__OMP_FOR(w->n) /* over blocks of SPH__BLOCK particles */
+    for (blk = 0; blk < (sph__idx)nblk; ++blk) {
+        const size_t i0 = (size_t)blk * SPH__BLOCK;
+        const size_t i1 = i0 + SPH__BLOCK < w->n ? i0 + SPH__BLOCK : w->n;
+        size_t i;
+        int k;
+        for (i = i0; i < i1; ++i)
+            for (k = 0; k < D; ++k) w->a[i * (size_t)D + (size_t)k] = c->g[k];
+        if (w->def.force) w->def.force(w, i0, i1, w->a, w->def.force_user);
     }
 }
 
@@ -2249,7 +2581,7 @@ static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, s
             return sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory (reduction blocks)");
         w->priv.block_cap = cap;
     }
-    SPH__OMP_FOR
+    SPH__OMP_FOR(w->n) /* over blocks of SPH__BLOCK particles */
     for (blk = 0; blk < (sph__idx)nblk; ++blk) {
         const size_t i0 = (size_t)blk * SPH__BLOCK;
         const size_t i1 = i0 + SPH__BLOCK < w->n ? i0 + SPH__BLOCK : w->n;
@@ -2276,7 +2608,7 @@ static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, s
                 }
             }
             if (!final) continue;
-            mi = (double)(w->m ? w->m[i] : w->priv.mass);
+            mi = (double)(w->m ? w->m[i] : w->mass);
             for (kk = 0; kk < D; ++kk) {
                 v2 += (double)vi[kk] * (double)vi[kk];
                 a2 += (double)ai[kk] * (double)ai[kk];
@@ -2369,6 +2701,7 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt) {
     s = sph__resolve_sound_speed(w);
     if (s != SPH_OK) return s;
     for (k = 0; k < SPH_STAGE_COUNT; ++k) w->stats.stage_time[k] = 0;
+    w->stats.step_time = 0;
     w->stats.dt = (double)dt;
     w->stats.iterations = 1;
     w->error[0] = 0;
@@ -2392,6 +2725,9 @@ static sph_status sph__prepare_forces(sph_world* w, sph__ctx* c, double t, doubl
         sph__time(w, SPH_STAGE_DENSITY, t0);
     }
     sph__stage_eos(w, c);
+    sph__time(w, SPH_STAGE_PRESSURE, t0);
+    sph__stage_body_force(w, c);
+    sph__time(w, SPH_STAGE_FORCES, t0);
     if (w->nb > 0) sph__stage_wall_pressure(w, c);
     sph__time(w, SPH_STAGE_PRESSURE, t0);
     return SPH_OK;
@@ -2464,7 +2800,7 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
     sph__ctx_init(w, &c);
     sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
     if (cont) {
-        SPH__OMP_FOR
+        SPH__OMP_FOR(w->n)
         for (i = 0; i < (sph__idx)w->n; ++i) {
             w->priv.rho_n[i] = w->rho[i];
             w->rho[i] += half * w->drho[i];
@@ -2474,6 +2810,9 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
     }
     sph__time(w, SPH_STAGE_DENSITY, &t0);
     sph__stage_eos(w, &c);
+    sph__time(w, SPH_STAGE_PRESSURE, &t0);
+    sph__stage_body_force(w, &c);
+    sph__time(w, SPH_STAGE_FORCES, &t0);
     if (w->nb > 0) sph__stage_wall_pressure(w, &c);
     sph__time(w, SPH_STAGE_PRESSURE, &t0);
     sph__stage_interact(w, &c, SPH__ACCEL);
@@ -2482,7 +2821,7 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
     if (s != SPH_OK) return s;
     if (cont) {
         sph__stage_interact(w, &c, SPH__RATE);
-        SPH__OMP_FOR
+        SPH__OMP_FOR(w->n)
         for (i = 0; i < (sph__idx)w->n; ++i) w->rho[i] = w->priv.rho_n[i] + dt * w->drho[i];
         sph__time(w, SPH_STAGE_DENSITY, &t0);
     }
@@ -2494,11 +2833,19 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
     return s;
 }
 
+/* Adds the step's timings to the world's totals. */
+static sph_status sph__step_end(sph_world* w, sph_status s) {
+    int k;
+    w->step_time_total += w->stats.step_time;
+    for (k = 0; k < SPH_STAGE_COUNT; ++k) w->stage_time_total[k] += w->stats.stage_time[k];
+    return s;
+}
+
 SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt) {
     sph_status s = sph__step_begin(w, dt);
     if (s != SPH_OK) return s;
-    if (w->def.integrator == SPH_INTEGRATOR_VERLET) return sph__step_wcsph_verlet(w, dt);
-    return sph__step_wcsph_euler(w, dt);
+    if (w->def.integrator == SPH_INTEGRATOR_VERLET) return sph__step_end(w, sph__step_wcsph_verlet(w, dt));
+    return sph__step_end(w, sph__step_wcsph_euler(w, dt));
 }
 
 /* >>stages: time step control */
@@ -2535,7 +2882,14 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
         return 0;
     }
     dt = (double)w->def.cfl * (double)w->h / (cmax + sqrt(v2max));
-    if (numax > 0) dt = fmin(dt, (double)w->def.cfl_viscous * (double)w->h * (double)w->h / numax);
+    /* The explicit viscous step is stable while dt nu lambda_max <= 2. A Fourier analysis of the
+       operators on a lattice (h = 1-2 dx, 2D and 3D) gives lambda_max = 2 / (C h^2 / nu) with
+       C = 0.29-0.36 (Morris form, cubic and Wendland C2), 0.50 (quintic), but only C = 0.112-0.15
+       for the 2(d+2) form; the default 0.125 keeps a margin for Morris, and the 2(d+2) form gets
+       0.8 of it. tests/test_wcsph.c checks the limit by running just below and above it. */
+    if (numax > 0)
+        dt = fmin(dt, (double)w->def.cfl_viscous * (w->def.viscosity_form == SPH_VISC_MONAGHAN ? 0.8 : 1.0) *
+                          (double)w->h * (double)w->h / numax);
     if (amax > 0) dt = fmin(dt, (double)w->def.cfl_force * sqrt((double)w->h / amax));
     return (sph_real)dt;
 }

@@ -1,0 +1,77 @@
+/* tests/harness.h - the tiny test harness of sph.h's tests.
+
+   A test is a void function registered in its file's table:
+
+       static void test_something(void) { CHECK(1 + 1 == 2); CHECK_NEAR(x, 1.0, 1e-6); }
+       const th_test tests_area[] = { {"area/something", test_something}, {0, 0} };
+
+   tests/main.c lists every table; `build/tests [filter...]` runs the tests whose name contains
+   any filter and ends with the line "N passed, N failed". TH_NOTE prints a measured number
+   (shown in the output so closing notes can quote it). TH_SKIP ends a test that cannot run in
+   this build (e.g. determinism without OpenMP); skips are counted separately. */
+#ifndef SPH_TEST_HARNESS_H
+#define SPH_TEST_HARNESS_H
+
+#include <stdio.h>
+
+typedef struct th_test {
+    const char* name;
+    void (*fn)(void);
+} th_test;
+
+/* Every test file's table (declared here so that `const` keeps external linkage in C++). */
+extern const th_test tests_kernels[];
+extern const th_test tests_grid[];
+extern const th_test tests_world[];
+extern const th_test tests_wcsph[];
+extern const th_test tests_compile[];
+
+void th_fail(const char* file, int line, const char* fmt, ...);
+void th_note(const char* fmt, ...);
+void th_skip(const char* reason);
+int th_skipped(void); /* nonzero after TH_SKIP in the running test */
+
+/* Precision-aware tolerances: TH_EPS is the machine epsilon of sph_real; TH_ROUNDOFF a loose
+   round-off level for results of many operations. */
+#ifdef SPH_FLOAT
+#define TH_EPS 1.1920929e-07
+#define TH_ROUNDOFF 1e-5
+#else
+#define TH_EPS 2.220446049250313e-16
+#define TH_ROUNDOFF 1e-12
+#endif
+
+#define CHECK(cond)                                                                                \
+    do { if (!(cond)) th_fail(__FILE__, __LINE__, "CHECK(%s)", #cond); } while (0)
+#define CHECK_MSG(cond, ...)                                                                       \
+    do { if (!(cond)) th_fail(__FILE__, __LINE__, __VA_ARGS__); } while (0)
+#define CHECK_NEAR(a, b, tol)                                                                      \
+    do {                                                                                           \
+        double th_a_ = (double)(a), th_b_ = (double)(b), th_t_ = (double)(tol);                    \
+        if (!(th_a_ - th_b_ <= th_t_ && th_b_ - th_a_ <= th_t_))                                   \
+            th_fail(__FILE__, __LINE__, "CHECK_NEAR(%s, %s, %s): %.10g vs %.10g (diff %.3g)", #a,  \
+                    #b, #tol, th_a_, th_b_, th_a_ - th_b_);                                        \
+    } while (0)
+#define CHECK_LT(a, b)                                                                             \
+    do {                                                                                           \
+        double th_a_ = (double)(a), th_b_ = (double)(b);                                           \
+        if (!(th_a_ < th_b_))                                                                      \
+            th_fail(__FILE__, __LINE__, "CHECK_LT(%s, %s): %.10g >= %.10g", #a, #b, th_a_, th_b_); \
+    } while (0)
+#define CHECK_LE(a, b)                                                                             \
+    do {                                                                                           \
+        double th_a_ = (double)(a), th_b_ = (double)(b);                                           \
+        if (!(th_a_ <= th_b_))                                                                     \
+            th_fail(__FILE__, __LINE__, "CHECK_LE(%s, %s): %.10g > %.10g", #a, #b, th_a_, th_b_);  \
+    } while (0)
+#define CHECK_EQ_INT(a, b)                                                                         \
+    do {                                                                                           \
+        long long th_a_ = (long long)(a), th_b_ = (long long)(b);                                  \
+        if (th_a_ != th_b_)                                                                        \
+            th_fail(__FILE__, __LINE__, "CHECK_EQ_INT(%s, %s): %lld vs %lld", #a, #b, th_a_,      \
+                    th_b_);                                                                        \
+    } while (0)
+#define TH_NOTE(...) th_note(__VA_ARGS__)
+#define TH_SKIP(reason) do { th_skip(reason); return; } while (0)
+
+#endif
