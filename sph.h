@@ -66,7 +66,8 @@ int main(void) {
    stored with stride dim (x[i*dim + k]), so a 2D world stores no third component. y is up:
    the default gravity is (0, -9.81) in 2D and (0, -9.81, 0) in 3D. The particle spacing dx sets
    the resolution and, with h_factor, the smoothing length h = h_factor * dx; the kernel support
-   is 2h or 3h. A particle of phase q has mass rest_density * dx^dim unless set otherwise.
+   is 2h or 3h. A particle has mass rest_density * dx^dim (its cell volume if sph_fill_box
+   adjusted the spacing to fit a box), unless sph_phase.mass says otherwise.
 
    KERNELS
    sph_kernel_init(&k, type, dim, h) then sph_kernel_w / _dwdr / _grad. Wendland C2 (default,
@@ -89,7 +90,9 @@ int main(void) {
    rejects an invalid field with SPH_ERR_ARG and a message naming it. Add phases (materials) with
    sph_world_add_phase, fluid with sph_fill_box / sph_add_fluid, walls with sph_add_wall_box /
    sph_add_boundary. The world is a caller-owned struct: read n, x, v, rho, p, id, phase, and
-   nb, b_x, b_v, b_p ... directly; positions and velocities may be written between steps.
+   nb, b_x, b_v, b_p ... directly; fluid positions and velocities may be written between steps.
+   Move boundary particles from def.boundary_motion: static walls are sorted into their grid once,
+   and only a motion callback (or adding particles) makes the library re-sort them.
    Particles are reordered by cell at every step: follow one by its id, not by its index. Array
    pointers change only when particles are added. A per-particle mass array (w.m) exists only
    when particles of different mass coexist; otherwise every particle has mass w.mass.
@@ -537,7 +540,9 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def);
 SPHDEF void sph_world_free(sph_world* w);
 /* Adds a phase; returns its index, or -1 with the reason in w->error. */
 SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase);
-/* Fills the box [lo, hi] with fluid of the phase on a lattice of spacing dx starting at lo. */
+/* Fills the box [lo, hi] with fluid of the phase: round(extent / dx) particles per direction,
+   at the spacing that fills the box exactly (dx when the extent is a whole number of spacings),
+   each with the rest density times its cell volume as mass. */
 SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, const sph_real* hi);
 /* Adds n fluid particles at x[i*dim + k] with velocities v (NULL = at rest), density rho0. */
 SPHDEF sph_status sph_add_fluid(sph_world* w, int phase, size_t n, const sph_real* x,
@@ -1665,22 +1670,29 @@ static sph_status sph__check_box(sph_world* w, const char* fn, const sph_real* l
 }
 
 SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, const sph_real* hi) {
+    /* round(extent / dx) particles per direction at the spacing that fills the box exactly (the
+       rule sph_add_wall_box uses, so a tank and its water line up); a particle's mass is the
+       phase's mass times its cell volume over dx^dim, i.e. rest density times cell volume. */
     const int dim = w ? w->dim : 0;
     size_t cnt[3] = {1, 1, 1}, total = 1, i;
-    sph_real* pts;
+    sph_real sp[3] = {0, 0, 0}, *pts;
+    double mass;
     sph_status s;
     int k;
     if (!w) return SPH_ERR_ARG;
     if (!sph__check_phase(w, phase)) return SPH_ERR_ARG;
     s = sph__check_box(w, "sph_fill_box", lo, hi);
     if (s != SPH_OK) return s;
+    mass = (double)w->phases[phase].mass;
     for (k = 0; k < dim; ++k) {
-        double c = floor((double)((hi[k] - lo[k]) / w->dx) + 1e-6);
+        double c = floor((double)((hi[k] - lo[k]) / w->dx) + 0.5);
         if (c < 1)
             return sph__fail(w, SPH_ERR_ARG, -1,
-                             "sph_fill_box: box is thinner than one spacing in direction %d", k);
+                             "sph_fill_box: box is thinner than half a spacing in direction %d", k);
         if (c > 1e7) return sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_fill_box: box too large");
         cnt[k] = (size_t)c;
+        sp[k] = (hi[k] - lo[k]) / (sph_real)c;
+        mass *= (double)sp[k] / (double)w->dx;
         total *= cnt[k];
     }
     if (total + w->n > (size_t)UINT32_MAX - 1)
@@ -1690,11 +1702,15 @@ SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, cons
     for (i = 0; i < total; ++i) { /* x fastest, as the cell sort would order them */
         size_t r = i;
         for (k = 0; k < dim; ++k) {
-            pts[i * (size_t)dim + (size_t)k] = lo[k] + ((sph_real)(r % cnt[k]) + SPH__R(0.5)) * w->dx;
+            pts[i * (size_t)dim + (size_t)k] = lo[k] + ((sph_real)(r % cnt[k]) + SPH__R(0.5)) * sp[k];
             r /= cnt[k];
         }
     }
-    s = sph__append_fluid(w, phase, total, pts, NULL, w->phases[phase].mass);
+    /* whole spacings keep the phase's mass bit for bit (no mass array for them) */
+    for (k = 0; k < dim; ++k)
+        if (sp[k] != w->dx) break;
+    s = sph__append_fluid(w, phase, total, pts, NULL,
+                          k == dim ? w->phases[phase].mass : (sph_real)mass);
     SPH_FREE(pts);
     return s;
 }

@@ -214,13 +214,40 @@ static void test_fill_and_masses(void) {
         CHECK_NEAR(w.rho[i], i < 150 ? 1000 : 800, 0);
     }
     CHECK_NEAR(sph_world_mass(&w), 150 * 1e-3 + 125 * 0.8e-3, 1e-12 + 300 * TH_EPS * 1e-3);
-    /* bad phase index and a box thinner than a spacing are rejected, nothing is added */
+    /* bad phase index and a box thinner than half a spacing are rejected, nothing is added */
     CHECK_EQ_INT(sph_fill_box(&w, 5, lo, hi), SPH_ERR_ARG);
-    hi[0] = 0.005;
+    hi[0] = 0.004;
     CHECK_EQ_INT(sph_fill_box(&w, a, lo, hi), SPH_ERR_ARG);
     hi[0] = (sph_real)NAN;
     CHECK_EQ_INT(sph_fill_box(&w, a, lo, hi), SPH_ERR_ARG);
     CHECK_EQ_INT(w.n, 275);
+    sph_world_free(&w);
+}
+
+/* A box that is not a whole number of spacings is still filled exactly: round(extent / dx)
+   particles per direction at the spacing that fits, masses rest density times cell volume, so
+   the total mass is rest density times the box volume. */
+static void test_fill_box_fits(void) {
+    sph_world_def d = sph_world_def_default(2);
+    sph_world w;
+    sph_phase water;
+    sph_real lo[2] = {0.1, 0}, hi[2] = {0.2049, 0.0312};
+    double xmin = 1, xmax = 0;
+    size_t i;
+    d.spacing = 0.01;
+    memset(&water, 0, sizeof(water));
+    water.rest_density = 1000;
+    CHECK_EQ_INT(sph_world_init(&w, &d), SPH_OK);
+    CHECK_EQ_INT(sph_world_add_phase(&w, &water), 0);
+    CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
+    CHECK_EQ_INT(w.n, 10 * 3); /* 10.49 -> 10 and 3.12 -> 3 spacings */
+    for (i = 0; i < w.n; ++i) {
+        xmin = fmin(xmin, (double)w.x[2 * i]);
+        xmax = fmax(xmax, (double)w.x[2 * i]);
+    }
+    CHECK_NEAR(xmin, 0.1 + 0.01049 / 2, 8 * TH_EPS);
+    CHECK_NEAR(xmax, 0.2049 - 0.01049 / 2, 8 * TH_EPS);
+    CHECK_NEAR(sph_world_mass(&w), 1000 * 0.1049 * 0.0312, 64 * TH_EPS);
     sph_world_free(&w);
 }
 
@@ -478,6 +505,7 @@ const th_test tests_world[] = {
     {"world/def_fields_rejected_by_name", test_def_fields},
     {"world/phase_fields_rejected_by_name", test_phase_fields},
     {"world/fill_box_counts_ids_masses", test_fill_and_masses},
+    {"world/fill_box_fits_the_box", test_fill_box_fits},
     {"world/wall_box_count_and_volume", test_wall_box},
     {"world/hydrostatic_init", test_hydrostatic_init},
     {"world/bad_step_input_leaves_world_unchanged", test_bad_step_input},
