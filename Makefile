@@ -3,6 +3,7 @@
 #   make demo      the 2D dam break: progress on stdout, PNG frames in out/
 #   make examples  every example, each built with one cc command
 #   make check     warnings (gcc, clang, C, C++), sanitizers, float, no-OpenMP and C++ test runs
+#   make validate  the long validation runs (tests marked long)
 
 CC      ?= cc
 CXX     ?= c++
@@ -15,13 +16,14 @@ CFLAGS  ?= $(OPT) -std=c99 $(WARN)
 B        = build
 
 TEST_SRC = tests/main.c tests/impl.c tests/test_kernels.c tests/test_grid.c \
-           tests/test_world.c tests/test_wcsph.c tests/test_compile.c tests/compile_second.c \
+           tests/test_world.c tests/test_wcsph.c tests/test_iisph.c tests/test_compile.c \
+           tests/compile_second.c \
            tests/compile_static.c
 TEST_CXX = tests/compile_cpp.cpp
 TEST_DEP = sph.h tests/harness.h examples/scenes.h $(TEST_SRC) $(TEST_CXX)
 EXAMPLES = hello dambreak
 
-.PHONY: test demo examples check check-warnings check-sanitize check-float check-noomp \
+.PHONY: test validate demo examples check check-warnings check-sanitize check-float check-noomp \
         check-cpp check-png clean
 
 test: $(B)/tests
@@ -31,6 +33,9 @@ test: $(B)/tests
 $(B)/tests: $(TEST_DEP) | $(B)
 	$(CXX) $(OPT) -std=c++11 $(WARN) $(OMP) -c $(TEST_CXX) -o $(B)/compile_cpp.o
 	$(CC) $(CFLAGS) $(OMP) $(TEST_SRC) $(B)/compile_cpp.o -o $@ -lm
+
+validate: $(B)/tests
+	./$(B)/tests --long -long/
 
 demo: $(B)/dambreak
 	./$(B)/dambreak

@@ -1,7 +1,8 @@
 /* sph.h - smoothed particle hydrodynamics in one header. MIT licence (see end of file).
 
    A plain-struct particle world, SPH kernels, a cell grid for neighbour search, and time steps
-   for weakly compressible SPH with dummy-particle walls, moving boundaries and user forces.
+   for weakly compressible SPH (WCSPH) and implicit incompressible SPH (IISPH) with particle
+   walls (three boundary pressure schemes), moving and irregular boundaries, and user forces.
    C99, also C++; libc and libm only; OpenMP when the compiler enables it.
 
    DO THIS in exactly one C or C++ file:
@@ -20,6 +21,7 @@
        >>boundaries    wall particles: Adami pressure extrapolation, no-slip
        >>stages        the shared stages; sph_stable_dt, sph_step, sph_advance
        >>wcsph         sph_step_wcsph
+       >>iisph         sph_step_iisph
        >>io            sph_write_csv, sph_write_vtk
 
    COMPILE-TIME OPTIONS (define before including the implementation)
@@ -112,6 +114,21 @@ int main(void) {
    (0.25 h / (c0 + |v|)), the viscous limit (0.125 h^2 / nu) and the force limit
    (0.25 sqrt(h / |a|)); sph_advance(&w, duration) steps with it, landing exactly on the end.
 
+   SOLVER: IISPH (sph_step_iisph, or def.solver = SPH_SOLVER_IISPH)
+   Implicit incompressible SPH (Ihmsen et al. 2014, seed 003): summation density, then a pressure
+   that makes the predicted density the rest density, by relaxed Jacobi (def.omega = 0.5) from a
+   warm start (0.5 of the last pressure), negative pressures clamped, until the mean predicted
+   compression is below def.tolerance (0.1 %) after min_iterations (2), at most max_iterations
+   (100); w.stats.iterations and .solver_error report the solve. Moving walls enter the source
+   term with their velocity. No equation of state: sound_speed only scales artificial viscosity
+   and the speed bound of the blow-up check (left 0 without gravity or motion, both are off).
+   sph_stable_dt lets a particle move cfl_velocity (0.4) spacings per step, within the viscous
+   and force limits. Iterations grow with depth and with dt; the time to solution has a minimum
+   (bench/bench.c iisph-sweep: at dt = 0.03 sqrt(dx/g), 5 iterations, in a 40-deep tank). The
+   pressure of single particles scatters by a few percent of rho g H while their densities hold;
+   layer averages follow hydrostatics to 1 %. Summation densities are divided by the kernel's
+   lattice sum so a lattice at spacing dx is exactly at rest density.
+
    BOUNDARIES
    Walls are layers of boundary particles with a volume each (sph_add_wall_box makes enough
    layers to cover the support). Their pressure is extrapolated from the fluid (Adami, Hu &
@@ -119,6 +136,13 @@ int main(void) {
    follows from the equation of state; a wall acts on a fluid particle like fluid of that
    particle's own rest density. Free slip (default) leaves walls out of the viscous terms;
    no-slip uses Adami's extrapolated wall velocity. Boundary particles can move: see callbacks.
+   def.boundary_pressure picks how the fluid sees a wall's pressure: extrapolated (default; the
+   only one that fits WCSPH), mirrored (p_b = p_i; dp/dn = 0 at the wall, so hydrostatic
+   pressure comes out steep) or zero (the wall-adjacent layer carries the load; with WCSPH
+   particles get through). def.boundary_volume = SPH_BVOL_AKINCI recomputes each wall particle's
+   volume from the wall particles around it whenever walls move (Akinci et al. 2012), for
+   single-layer and non-uniformly sampled walls; with boundary_gamma = 1 a flat single layer
+   weighs about three layers, so the fluid keeps a little off it but cannot leak through.
 
    CALLBACKS AND THREADS
    def.force: adds body accelerations for a range of fluid particles; called from worker threads
@@ -156,7 +180,7 @@ int main(void) {
    wall-clock time per stage; w.step_time_total and w.stage_time_total accumulate them.
 
    WHAT IT DOES NOT DO (yet)
-   Only the WCSPH solver is in this version; PCISPH, IISPH and the explicit compressible
+   The WCSPH and IISPH solvers are in this version; PCISPH and the explicit compressible
    multiphase step are planned. No surface tension, no turbulence model, no rigid-body coupling
    (boundaries move kinematically), no adaptive resolution, no GPU.
 */
@@ -332,7 +356,8 @@ SPHDEF void sph_neighbors_free(sph_neighbors* nl);
 /* ============================================================================================== */
 
 typedef enum sph_solver {
-    SPH_SOLVER_WCSPH = 0 /* weakly compressible SPH with an equation of state                 */
+    SPH_SOLVER_WCSPH = 0, /* weakly compressible SPH with an equation of state                */
+    SPH_SOLVER_IISPH      /* implicit incompressible SPH (Ihmsen et al. 2014), relaxed Jacobi  */
 } sph_solver;
 
 typedef enum sph_density {
@@ -357,6 +382,26 @@ typedef enum sph_viscosity_form {
     SPH_VISC_MONAGHAN    /* Monaghan 2005 / seed 000 eq. 2.5: 2(d+2) ... (v_ij.x_ij) grad W_ij;
                             conserves angular momentum, less accurate on a lattice            */
 } sph_viscosity_form;
+
+/* How a fluid particle sees the pressure of a wall particle (seed 003 sec. 4.2). */
+typedef enum sph_boundary_pressure {
+    SPH_BP_EXTRAPOLATE = 0, /* Adami et al. 2012: p_b from the fluid with body force and wall
+                               acceleration (default)                                         */
+    SPH_BP_MIRROR,          /* p_b = p_i, rho_b = rho_i (Koschier et al. 2020)                  */
+    SPH_BP_ZERO             /* p_b = 0 (Akinci et al. 2012 as used by Ihmsen et al. 2014)      */
+} sph_boundary_pressure;
+
+/* Where wall particle volumes come from. */
+typedef enum sph_boundary_volume {
+    SPH_BVOL_GIVEN = 0, /* as added (dx^dim, or the array given to sph_add_boundary) (default) */
+    SPH_BVOL_AKINCI     /* V_b = gamma / sum_b' W_bb' over wall neighbours, recomputed whenever
+                           walls move (Akinci et al. 2012): for single-layer and irregularly
+                           sampled walls (lattice walls of several layers keep GIVEN). With
+                           gamma = 1 and h = 1.3 dx a flat single layer weighs about three
+                           layers: the fluid stands a little off it, but cannot leak through;
+                           a gamma that matches the rest density (about 0.58) lets particles
+                           that reach the layer's line pass between its particles            */
+} sph_boundary_volume;
 
 typedef enum sph_wall {
     SPH_WALL_FREE_SLIP = 0, /* no viscous interaction with wall particles (default)             */
@@ -425,9 +470,19 @@ typedef struct sph_world_def {
     sph_real beta;             /* Monaghan artificial viscosity beta; default 0; [0, 10]          */
     sph_viscosity_form viscosity_form; /* laminar viscosity operator; default SPH_VISC_MORRIS    */
     sph_wall wall;             /* default SPH_WALL_FREE_SLIP                                      */
+    sph_boundary_pressure boundary_pressure; /* default SPH_BP_EXTRAPOLATE                        */
+    sph_boundary_volume boundary_volume;     /* default SPH_BVOL_GIVEN                            */
+    sph_real boundary_gamma;   /* Akinci volume factor gamma_1 (seed 003 eq. 27); default 1      */
     sph_real cfl;              /* acoustic CFL number for sph_stable_dt; default 0.25; (0, 1]     */
     sph_real cfl_viscous;      /* viscous limit dt <= cfl_viscous h^2 / nu; default 0.125         */
     sph_real cfl_force;        /* force limit dt <= cfl_force sqrt(h / |a|); default 0.25         */
+    sph_real cfl_velocity;     /* incompressible solvers: dt <= cfl_velocity dx / |v|max; 0.4     */
+    /* iterative pressure solvers (IISPH) */
+    sph_real tolerance;        /* stop when the mean predicted compression <= tolerance; 0.001     */
+    int min_iterations;        /* default 2                                                       */
+    int max_iterations;        /* default 100                                                     */
+    sph_real omega;            /* relaxed Jacobi weight; default 0.5                              */
+    sph_real warm_start;       /* initial pressure = warm_start * last step's pressure; 0.5       */
     sph_real domain_lo[3];     /* [m] domain box; particles outside are counted in                */
     sph_real domain_hi[3];     /*     w.stats.n_outside. lo == hi in a direction: unbounded there  */
     int periodic[3];           /* nonzero: direction wraps over [domain_lo, domain_hi)            */
@@ -456,8 +511,10 @@ typedef struct sph_phase {
 typedef struct sph_stats {
     double dt;                /* [s]                                                              */
     int iterations;           /* solver iterations (1 for WCSPH)                                   */
+    double solver_error;      /* iterative solvers: mean predicted compression at the last iteration */
     double density_error_avg; /* mean |rho/rho0 - 1| over fluid particles                          */
     double density_error_max; /* max |rho/rho0 - 1|                                               */
+    double compression_avg;   /* mean max(rho/rho0 - 1, 0): compression only (seed 003 eq. 15)    */
     double v_max;             /* [m/s]                                                             */
     double a_max;             /* largest acceleration of the step [m/s^2]                          */
     double kinetic_energy;    /* sum 1/2 m |v|^2 [J]                                               */
@@ -470,15 +527,23 @@ typedef struct sph_stats {
 /* Private state (do not touch). */
 typedef struct sph__private {
     sph_grid grid, bgrid;           /* fluid and boundary grids (same cells)                       */
-    sph_neighbors ff, fb, bf;       /* fluid->fluid, fluid->boundary, boundary->fluid              */
+    sph_neighbors ff, fb, bf, bb;   /* fluid->fluid, fluid->boundary, boundary->fluid, ->boundary  */
     uint8_t* perm_buf;              /* permutation scratch, capacity * largest element              */
     size_t perm_cap;                /* bytes                                                        */
     double* block;                  /* per-block partial reductions                                 */
     size_t block_cap;
     sph_real* rho_n;                /* Verlet: density at the start of the step (scratch)          */
     size_t rho_n_cap;
+    sph_real *aii, *src, *ap;       /* IISPH: diagonal, source, pressure acceleration (scratch)     */
+    size_t aii_cap, src_cap, ap_cap;
+    sph_real *ff_fw, *fb_fw;        /* iterative solvers: grad W_ij / x_ij per listed pair          */
+    size_t ff_fw_cap, fb_fw_cap;
+    sph_real* pr2;                  /* iterative solvers: p_i / rho_i^2 (scratch)                   */
+    size_t pr2_cap;
+    sph_real* b_sw;                 /* per wall particle: sum_f W_bf of its fluid neighbours        */
     int b_dirty;                    /* boundary particles changed since the last boundary grid     */
     int have_mass;                  /* w->mass is set                                               */
+    sph_real lattice_sum;           /* dx^dim sum_j W(x_j) over a square lattice of spacing dx     */
 } sph__private;
 
 /* The world: a caller-owned plain struct. Read the arrays directly; positions and velocities may
@@ -584,6 +649,15 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration);
 
 /* One weakly compressible step of dt [s]. On SPH_ERR_ARG the world is unchanged. */
 SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt);
+
+/* ============================================================================================== */
+/* >>iisph                                                                                        */
+/* ============================================================================================== */
+
+/* One implicit incompressible step of dt [s] (Ihmsen et al. 2014; seed 003): the pressure makes
+   the predicted density rest density to def.tolerance on average. w->stats.iterations and
+   .solver_error report the solve. On SPH_ERR_ARG the world is unchanged. */
+SPHDEF sph_status sph_step_iisph(sph_world* w, sph_real dt);
 
 /* ============================================================================================== */
 /* >>io                                                                                           */
@@ -1361,6 +1435,15 @@ SPHDEF sph_world_def sph_world_def_default(int dim) {
     d.cfl_force = SPH__R(0.25);
     d.max_compression = SPH__R(0.2);
     d.max_speed = 0;
+    d.boundary_pressure = SPH_BP_EXTRAPOLATE;
+    d.boundary_volume = SPH_BVOL_GIVEN;
+    d.boundary_gamma = 1;
+    d.cfl_velocity = SPH__R(0.4); /* seed 003 eq. 14 */
+    d.tolerance = SPH__R(0.001);  /* 0.1 % mean compression, seed 003 */
+    d.min_iterations = 2;
+    d.max_iterations = 100;
+    d.omega = SPH__R(0.5);        /* Ihmsen et al. 2014; seed 003 */
+    d.warm_start = SPH__R(0.5);   /* Ihmsen et al. 2014 */
     return d;
 }
 
@@ -1381,8 +1464,31 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
     for (k = 0; k < 3; ++k)
         SPH__CHECK(sph__finite((double)d->gravity[k]), "sph_world_def.gravity[%d] = %g: not finite",
                    k, (double)d->gravity[k]);
-    SPH__CHECK(d->solver == SPH_SOLVER_WCSPH, "sph_world_def.solver = %d: not a sph_solver",
-               (int)d->solver);
+    SPH__CHECK((int)d->solver >= 0 && d->solver <= SPH_SOLVER_IISPH,
+               "sph_world_def.solver = %d: not a sph_solver", (int)d->solver);
+    SPH__CHECK((int)d->boundary_pressure >= 0 && d->boundary_pressure <= SPH_BP_ZERO,
+               "sph_world_def.boundary_pressure = %d: not a sph_boundary_pressure",
+               (int)d->boundary_pressure);
+    SPH__CHECK((int)d->boundary_volume >= 0 && d->boundary_volume <= SPH_BVOL_AKINCI,
+               "sph_world_def.boundary_volume = %d: not a sph_boundary_volume",
+               (int)d->boundary_volume);
+    SPH__CHECK(sph__finite((double)d->boundary_gamma) && d->boundary_gamma > 0 &&
+                   d->boundary_gamma <= 10,
+               "sph_world_def.boundary_gamma = %g: must be in (0, 10]", (double)d->boundary_gamma);
+    SPH__CHECK(sph__finite((double)d->cfl_velocity) && d->cfl_velocity > 0 && d->cfl_velocity <= 1,
+               "sph_world_def.cfl_velocity = %g: must be in (0, 1]", (double)d->cfl_velocity);
+    SPH__CHECK(sph__finite((double)d->tolerance) && d->tolerance > 0 && d->tolerance < 1,
+               "sph_world_def.tolerance = %g: must be in (0, 1)", (double)d->tolerance);
+    SPH__CHECK(d->min_iterations >= 0 && d->min_iterations <= 100000,
+               "sph_world_def.min_iterations = %d: must be in [0, 100000]", d->min_iterations);
+    SPH__CHECK(d->max_iterations >= 1 && d->max_iterations <= 100000 &&
+                   d->max_iterations >= d->min_iterations,
+               "sph_world_def.max_iterations = %d: must be in [max(1, min_iterations), 100000]",
+               d->max_iterations);
+    SPH__CHECK(sph__finite((double)d->omega) && d->omega > 0 && d->omega <= 1,
+               "sph_world_def.omega = %g: must be in (0, 1]", (double)d->omega);
+    SPH__CHECK(sph__finite((double)d->warm_start) && d->warm_start >= 0 && d->warm_start <= 1,
+               "sph_world_def.warm_start = %g: must be in [0, 1]", (double)d->warm_start);
     SPH__CHECK((int)d->density >= 0 && d->density <= SPH_DENSITY_PARTICLE,
                "sph_world_def.density = %d: not a sph_density", (int)d->density);
     SPH__CHECK((int)d->pressure_grad >= 0 && d->pressure_grad <= SPH_PGRAD_MULTIPHASE,
@@ -1421,6 +1527,21 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
     return SPH_OK;
 }
 
+/* dx^dim sum_j W(|x_j|) over a square lattice of spacing dx, the particle itself included:
+   the summation density of a lattice in units of m / dx^dim (1.0105 for Wendland C2, 2D,
+   h = 1.3 dx). */
+static sph_real sph__lattice_sum(const sph_kernel* k, sph_real dx) {
+    const int R = (int)(k->radius / dx) + 1, D = k->dim;
+    double sum = 0, vol = 1;
+    int i, j, l;
+    for (i = 0; i < D; ++i) vol *= (double)dx;
+    for (i = -R; i <= R; ++i)
+        for (j = (D > 1 ? -R : 0); j <= (D > 1 ? R : 0); ++j)
+            for (l = (D > 2 ? -R : 0); l <= (D > 2 ? R : 0); ++l)
+                sum += (double)sph_kernel_w(k, dx * sph__sqrt((sph_real)(i * i + j * j + l * l)));
+    return (sph_real)(sum * vol);
+}
+
 SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
     sph_status s;
     sph_real hf, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
@@ -1444,6 +1565,7 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
     w->h = hf * def->spacing;
     s = sph_kernel_init(&w->kernel, def->kernel, def->dim, w->h);
     if (s != SPH_OK) return sph__fail(w, s, -1, "sph_world_init: kernel setup failed");
+    w->priv.lattice_sum = sph__lattice_sum(&w->kernel, w->dx);
     for (k = 0; k < def->dim; ++k) {
         per[k] = def->periodic[k] != 0;
         lo[k] = def->domain_lo[k];
@@ -1473,9 +1595,16 @@ SPHDEF void sph_world_free(sph_world* w) {
     sph_neighbors_free(&w->priv.ff);
     sph_neighbors_free(&w->priv.fb);
     sph_neighbors_free(&w->priv.bf);
+    sph_neighbors_free(&w->priv.bb);
     SPH_FREE(w->priv.perm_buf);
     SPH_FREE(w->priv.block);
     SPH_FREE(w->priv.rho_n);
+    SPH_FREE(w->priv.aii);
+    SPH_FREE(w->priv.src);
+    SPH_FREE(w->priv.ap);
+    SPH_FREE(w->priv.ff_fw);
+    SPH_FREE(w->priv.fb_fw);
+    SPH_FREE(w->priv.pr2);
     memset(w, 0, sizeof(*w));
     w->error_index = -1;
 }
@@ -1519,6 +1648,7 @@ static int sph__boundary_arrays(sph_world* w, sph__array* a) {
     a[n].ptr = (void**)&w->b_p; a[n].elem = r; a[n++].persistent = 0;
     a[n].ptr = (void**)&w->b_rho; a[n].elem = r; a[n++].persistent = 0;
     a[n].ptr = (void**)&w->b_vw; a[n].elem = vec; a[n++].persistent = 0;
+    a[n].ptr = (void**)&w->priv.b_sw; a[n].elem = r; a[n++].persistent = 0;
     return n;
 }
 
@@ -1874,9 +2004,11 @@ SPHDEF size_t sph_world_memory(const sph_world* w) {
     for (k = 0; k < n; ++k) bytes += w->b_capacity * arr[k].elem;
     bytes += sph__grid_memory(&w->priv.grid) + sph__grid_memory(&w->priv.bgrid);
     bytes += sph__neighbors_memory(&w->priv.ff) + sph__neighbors_memory(&w->priv.fb) +
-             sph__neighbors_memory(&w->priv.bf);
+             sph__neighbors_memory(&w->priv.bf) + sph__neighbors_memory(&w->priv.bb);
     bytes += w->priv.perm_cap + w->priv.block_cap * sizeof(double) +
-             w->priv.rho_n_cap * sizeof(sph_real);
+             (w->priv.rho_n_cap + w->priv.aii_cap + w->priv.src_cap + w->priv.ap_cap +
+              w->priv.ff_fw_cap + w->priv.fb_fw_cap + w->priv.pr2_cap) *
+                 sizeof(sph_real);
     return bytes;
 }
 
@@ -1951,6 +2083,11 @@ typedef struct sph__ctx {
     sph__phase_c pc[SPH_MAX_PHASES];
     const sph_neighbors *ff, *fb, *bf;
     int density, pgrad, noslip, laminar, morris, av, delta_on;
+    int bp_mode;               /* sph_boundary_pressure                                          */
+    const sph_real *ff_fw, *fb_fw; /* cached grad W factors per listed pair (SPH__CACHED passes)  */
+    const sph_real* pr2;       /* p / rho^2 per fluid particle (SPH__CACHED passes)              */
+    int eos_walls;             /* wall density from the equation of state (WCSPH) or a Shepard
+                                  average of the fluid's (solvers without one, seed 000 sec. 3.2.3) */
     sph_real alpha, beta, delta, visc_k;
     sph_real g[3];
 } sph__ctx;
@@ -1996,6 +2133,8 @@ static void sph__ctx_init(sph_world* w, sph__ctx* c) {
     c->density = (int)w->def.density;
     c->pgrad = (int)w->def.pressure_grad;
     c->noslip = w->def.wall == SPH_WALL_NO_SLIP;
+    c->bp_mode = (int)w->def.boundary_pressure;
+    c->eos_walls = w->def.solver == SPH_SOLVER_WCSPH;
     c->morris = w->def.viscosity_form == SPH_VISC_MORRIS;
     c->alpha = w->def.alpha;
     c->beta = w->def.beta;
@@ -2017,55 +2156,73 @@ SPH__INLINE void sph__delta_vec(const sph__ctx* c, const sph_real* a, const sph_
     }
 }
 
-/* Adami, Hu & Adams 2012, eq. 27: the pressure of wall particle b extrapolated from its fluid
-   neighbours f, with the wall's acceleration a_b (moving walls):
-       p_b = (sum_f p_f W_bf + (g - a_b) . sum_f rho_f x_bf W_bf) / sum_f W_bf,  x_bf = x_b - x_f.
-   g is the body acceleration of the fluid: gravity plus the user force callback, taken per fluid
-   particle (w->a holds it when this stage runs), so a force field that replaces gravity gives
-   the same walls as gravity.
-   The wall density follows from each neighbouring phase's equation of state (Adami eq. 28),
-   stored relative to rest as b_rho[b] = sum_f W_bf (rho/rho0)_f(p_b) / sum_f W_bf.
-   No-slip (Adami eqs. 22-23): the viscous terms see v~_b = 2 v_b - sum_f v_f W_bf / sum_f W_bf. */
-static void sph__stage_wall_pressure(sph_world* w, const sph__ctx* c) {
+/* Wall particles see their fluid neighbours f through Shepard averages (weights W_bf / sum_f W_bf).
+   STATE (once per step): the sum b_sw = sum_f W_bf; for no-slip, Adami et al. 2012 eqs. 22-23:
+       v~_b = 2 v_b - sum_f v_f W_bf / sum_f W_bf        (the velocity viscous terms see)
+   and, for solvers without an equation of state, the wall density relative to rest as the
+   Shepard average of rho_f/rho0_f (seed 000 sec. 3.2.3's rho_w = sum_f rho_f W_bf / sum_f W_bf).
+   PRESSURE (with SPH_BP_EXTRAPOLATE), Adami et al. 2012, eq. 27:
+       p_b = (sum_f p_f W_bf + sum_f rho_f (g_f - a_b) . x_bf W_bf) / sum_f W_bf, x_bf = x_b - x_f,
+   with g_f the body acceleration of fluid particle f (gravity, the user's forces and, for the
+   iterative solvers, viscosity: w->a holds it when this runs) and a_b the wall's acceleration; so
+   a force field that replaces gravity gives the same walls as gravity. With an equation of state
+   the wall density follows from each neighbouring phase's (Adami eq. 28):
+       b_rho[b] = sum_f W_bf (rho/rho0)_f(p_b) / sum_f W_bf.
+   A wall particle without fluid neighbours has p_b = 0, b_rho = 1 and v~_b = v_b. */
+enum { SPH__WALL_STATE = 1, SPH__WALL_PRESSURE = 2 };
+
+static void sph__stage_wall(sph_world* w, const sph__ctx* c, int parts) {
     const int D = c->dim;
+    const int pressure = (parts & SPH__WALL_PRESSURE) && c->bp_mode == SPH_BP_EXTRAPOLATE;
     sph__idx b;
+    if (!(parts & SPH__WALL_STATE) && !pressure) return;
     SPH__OMP_FOR(w->nb)
     for (b = 0; b < (sph__idx)w->nb; ++b) {
         const sph_neighbors* nl = c->bf;
-        const sph_real* xb = c->bx + (size_t)b * (size_t)D;
-        sph_real sw = 0, swp = 0, sgx = 0, sv[3] = {0, 0, 0}, wph[SPH_MAX_PHASES];
+        const size_t bD = (size_t)b * (size_t)D;
+        const sph_real* xb = c->bx + bD;
+        sph_real sw = 0, swp = 0, sgx = 0, srr = 0, sv[3] = {0, 0, 0}, wph[SPH_MAX_PHASES];
         size_t kk, k0 = nl->begin[b], k1 = k0 + nl->count[b];
         int k, q;
         for (q = 0; q < c->nphase; ++q) wph[q] = 0;
         for (kk = k0; kk < k1; ++kk) {
-            const size_t f = nl->idx[kk];
+            const size_t f = nl->idx[kk], fD = f * (size_t)D;
             sph_real d[3] = {0, 0, 0}, r2 = 0, W;
-            sph__delta_vec(c, xb, c->x + f * (size_t)D, d, D);
+            sph__delta_vec(c, xb, c->x + fD, d, D);
             for (k = 0; k < D; ++k) r2 += d[k] * d[k];
             W = sph__kw(c->k.form, sph__sqrt(r2) * c->k.inv_h);
             sw += W;
-            swp += c->p[f] * W;
-            for (k = 0; k < D; ++k) { /* rho_f (g_f - a_b) . x_bf W_bf */
-                sgx += c->rho[f] * (w->a[f * (size_t)D + (size_t)k] -
-                                    w->b_a[(size_t)b * (size_t)D + (size_t)k]) * d[k] * W;
-                sv[k] += c->v[f * (size_t)D + (size_t)k] * W;
+            if (pressure) {
+                swp += c->p[f] * W;
+                for (k = 0; k < D; ++k) /* rho_f (g_f - a_b) . x_bf W_bf */
+                    sgx += c->rho[f] * (w->a[fD + (size_t)k] - w->b_a[bD + (size_t)k]) * d[k] * W;
+                wph[c->ph[f]] += W;
             }
-            wph[c->ph[f]] += W;
+            if (parts & SPH__WALL_STATE) {
+                for (k = 0; k < D; ++k) sv[k] += c->v[fD + (size_t)k] * W;
+                srr += c->rho[f] * c->pc[c->ph[f]].inv_rho0 * W;
+            }
         }
-        if (sw > 0) {
-            sph_real pb = (swp + sgx) / sw, kap = 0;
-            for (q = 0; q < c->nphase; ++q)
-                if (wph[q] > 0) kap += wph[q] * sph__eos_inverse(&c->pc[q], pb);
+        if (parts & SPH__WALL_STATE) {
+            w->priv.b_sw[b] = sw;
+            for (k = 0; k < D; ++k)
+                w->b_vw[bD + (size_t)k] = sw > 0 ? 2 * c->bv[bD + (size_t)k] - sv[k] / sw : c->bv[bD + (size_t)k];
+            if (!c->eos_walls) w->b_rho[b] = sw > 0 ? srr / sw : 1;
+            if (c->bp_mode != SPH_BP_EXTRAPOLATE) w->b_p[b] = 0;
+        }
+        if (pressure) {
+            sph_real pb = 0, kap = 0;
+            if (sw > 0) {
+                pb = (swp + sgx) / sw;
+                if (c->eos_walls) {
+                    for (q = 0; q < c->nphase; ++q)
+                        if (wph[q] > 0) kap += wph[q] * sph__eos_inverse(&c->pc[q], pb);
+                    w->b_rho[b] = kap / sw;
+                }
+            } else if (c->eos_walls) {
+                w->b_rho[b] = 1;
+            }
             w->b_p[b] = pb;
-            w->b_rho[b] = kap / sw;
-            for (k = 0; k < D; ++k)
-                w->b_vw[(size_t)b * (size_t)D + (size_t)k] =
-                    2 * c->bv[(size_t)b * (size_t)D + (size_t)k] - sv[k] / sw;
-        } else {
-            w->b_p[b] = 0;
-            w->b_rho[b] = 1;
-            for (k = 0; k < D; ++k)
-                w->b_vw[(size_t)b * (size_t)D + (size_t)k] = c->bv[(size_t)b * (size_t)D + (size_t)k];
         }
     }
 }
@@ -2211,7 +2368,14 @@ SPHDEF sph_status sph_set_hydrostatic(sph_world* w) {
 
 /* A per-particle scratch array of at least `count` reals, kept between steps. */
 static sph_status sph__scratch(sph_world* w, sph_real** p, size_t count) {
-    size_t* cap = p == &w->priv.rho_n ? &w->priv.rho_n_cap : NULL;
+    size_t* cap = p == &w->priv.rho_n   ? &w->priv.rho_n_cap
+                  : p == &w->priv.aii   ? &w->priv.aii_cap
+                  : p == &w->priv.src   ? &w->priv.src_cap
+                  : p == &w->priv.ap    ? &w->priv.ap_cap
+                  : p == &w->priv.ff_fw ? &w->priv.ff_fw_cap
+                  : p == &w->priv.fb_fw ? &w->priv.fb_fw_cap
+                  : p == &w->priv.pr2   ? &w->priv.pr2_cap
+                                        : NULL;
     SPH_ASSERT(cap);
     if (count <= *cap && *p) return SPH_OK;
     if (!sph__grow((void**)p, count, sizeof(sph_real)))
@@ -2248,6 +2412,51 @@ static void sph__permute(sph_world* w, const sph__array* arr, int narr, const ui
     }
 }
 
+#ifdef SPH_VALIDATE
+/* Brute force: how many of the n points pts lie within radius of p (p itself included). */
+static size_t sph__count_within(const sph_grid* g, const sph_real* p, const sph_real* pts,
+                                size_t n, sph_real radius) {
+    size_t q, count = 0;
+    for (q = 0; q < n; ++q) {
+        sph_real d[3], r2 = 0;
+        int k;
+        sph_grid_delta(g, p, pts + q * (size_t)g->dim, d);
+        for (k = 0; k < g->dim; ++k) r2 += d[k] * d[k];
+        if (r2 < radius * radius) ++count;
+    }
+    return count;
+}
+#endif
+
+/* Akinci et al. 2012 (seed 003 eq. 27): a wall particle's volume is gamma_1 over its number
+   density among wall particles, V_b = gamma_1 S / sum_b' W_bb' (b itself included; S the
+   lattice sum, so a full lattice of wall particles keeps V_b = dx^dim), so sparse or single-layer
+   walls weigh as much as a full lattice and dense clusters do not count twice. Recomputed
+   whenever the walls are re-sorted (every step when they move). */
+static sph_status sph__stage_boundary_volume(sph_world* w) {
+    const int D = w->dim;
+    const sph_real R = w->kernel.radius, w0 = sph__kw(w->kernel.form, 0);
+    sph__idx b;
+    sph_status s = sph__neighbors_build(&w->priv.bb, &w->priv.bgrid, w->b_x, NULL, w->b_x, w->nb, R, 1);
+    if (s != SPH_OK) return sph__fail(w, s, -1, "boundary neighbour lists: %s", sph_status_string(s));
+    SPH__OMP_FOR(w->nb)
+    for (b = 0; b < (sph__idx)w->nb; ++b) {
+        const sph_neighbors* nl = &w->priv.bb;
+        size_t kk, k0 = nl->begin[b], k1 = k0 + nl->count[b];
+        sph_real sum = w0;
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t q = nl->idx[kk];
+            sph_real d[3] = {0, 0, 0}, r2 = 0;
+            int k;
+            sph_grid_delta(&w->priv.bgrid, w->b_x + (size_t)b * (size_t)D, w->b_x + q * (size_t)D, d);
+            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+            sum += sph__kw(w->kernel.form, sph__sqrt(r2) * w->kernel.inv_h);
+        }
+        w->b_vol[b] = w->def.boundary_gamma * w->priv.lattice_sum / (w->kernel.norm_w * sum);
+    }
+    return SPH_OK;
+}
+
 /* Neighbours stage: sort fluid (and moving boundary) particles by cell, then build the lists
    fluid->fluid, fluid->boundary and boundary->fluid once for the whole step. */
 static sph_status sph__stage_neighbors(sph_world* w) {
@@ -2265,6 +2474,10 @@ static sph_status sph__stage_neighbors(sph_world* w) {
         narr = sph__boundary_arrays(w, arr);
         sph__permute(w, arr, narr, w->priv.bgrid.order, w->nb);
         w->priv.b_dirty = 0;
+        if (w->def.boundary_volume == SPH_BVOL_AKINCI) {
+            s = sph__stage_boundary_volume(w);
+            if (s != SPH_OK) return s;
+        }
     }
     s = sph__neighbors_build(&w->priv.ff, &w->priv.grid, w->x, NULL, w->x, w->n, R, 1);
     if (s == SPH_OK && w->nb > 0) {
@@ -2288,23 +2501,9 @@ static sph_status sph__stage_neighbors(sph_world* w) {
         }
         if (w->steps % 97 == 0 && w->n <= 5000 && w->nb <= 5000) {
             for (i = 0; i < w->n; ++i) {
-                size_t nf = 0, nbd = 0;
-                for (q = 0; q < w->n; ++q) {
-                    sph_real d[3];
-                    int k;
-                    sph_real r2 = 0;
-                    sph_grid_delta(&w->priv.grid, w->x + i * (size_t)w->dim, w->x + q * (size_t)w->dim, d);
-                    for (k = 0; k < w->dim; ++k) r2 += d[k] * d[k];
-                    if (q != i && r2 < R * R) ++nf;
-                }
-                for (q = 0; q < w->nb; ++q) {
-                    sph_real d[3];
-                    int k;
-                    sph_real r2 = 0;
-                    sph_grid_delta(&w->priv.grid, w->x + i * (size_t)w->dim, w->b_x + q * (size_t)w->dim, d);
-                    for (k = 0; k < w->dim; ++k) r2 += d[k] * d[k];
-                    if (r2 < R * R) ++nbd;
-                }
+                const sph_real* xi = w->x + i * (size_t)w->dim;
+                const size_t nf = sph__count_within(&w->priv.grid, xi, w->x, w->n, R) - 1;
+                const size_t nbd = sph__count_within(&w->priv.grid, xi, w->b_x, w->nb, R);
                 SPH_ASSERT(nf == w->priv.ff.count[i]);
                 SPH_ASSERT(w->nb == 0 || nbd == w->priv.fb.count[i]);
             }
@@ -2315,7 +2514,10 @@ static sph_status sph__stage_neighbors(sph_world* w) {
 }
 
 /* Summation density (seed 000 eq. 2.4), walls as psi = rho0_i V_b (Akinci et al. 2012):
-       rho_i = m_i W(0) + sum_f m_f W_if + sum_b rho0_i V_b W_ib. */
+       rho_i = (m_i W(0) + sum_f m_f W_if + sum_b rho0_i V_b W_ib) / S,
+   S = the kernel's lattice sum (sph__lattice_sum): a particle lattice at spacing dx then has the
+   rest density exactly, instead of 1 % more for Wendland C2 at h = 1.3 dx, which an incompressible
+   solver would remove by expanding the fluid (seed 003's reference code scales W the same way). */
 static void sph__stage_density_summation(sph_world* w, const sph__ctx* c) {
     const int D = c->dim;
     const sph_real w0 = c->k.norm_w * sph__kw(c->k.form, 0);
@@ -2345,7 +2547,7 @@ static void sph__stage_density_summation(sph_world* w, const sph__ctx* c) {
                 sumb += c->bvol[b] * sph__kw(c->k.form, sph__sqrt(r2) * c->k.inv_h);
             }
         }
-        w->rho[i] = mi * w0 + c->k.norm_w * (sum + c->pc[c->ph[i]].rho0 * sumb);
+        w->rho[i] = (mi * w0 + c->k.norm_w * (sum + c->pc[c->ph[i]].rho0 * sumb)) / w->priv.lattice_sum;
     }
 }
 
@@ -2360,25 +2562,29 @@ static void sph__stage_eos(sph_world* w, const sph__ctx* c) {
     }
 }
 
-enum { SPH__ACCEL = 1, SPH__RATE = 2 };
+/* What a pass of the neighbour loop computes: pressure acceleration, viscous acceleration,
+   density rate; SET overwrites the acceleration output instead of adding to it. */
+enum { SPH__PRESSURE = 1, SPH__VISCOUS = 2, SPH__RATE = 4, SPH__SET = 8, SPH__CACHED = 16 };
+#define SPH__ACCEL (SPH__PRESSURE | SPH__VISCOUS)
 
 /* The one neighbour loop for accelerations and the density rate of fluid particle i.
-   ACCEL: pressure gradient (seed 000 sec. 2.2.1: sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W_ij,
-          or the multiphase form (p_i + p_j)/(rho_i rho_j), Ott & Schnetter eq. 12), laminar
-          viscosity (Morris et al. 1997: sum_j m_j (mu_i + mu_j)/(rho_i rho_j) x_ij.grad W_ij/
-          (r^2+eta^2) v_ij, which needs only the second moment of grad W to give nu Lap v, 0.96 of
-          it on a lattice with Wendland C2 at h = 1.3 dx; or Monaghan 2005 / seed 000 eq. 2.5,
-          2(d+2) sum_j m_j nu_bar/rho_bar v_ij.x_ij/(r^2+eta^2) grad W, which conserves angular
-          momentum but needs the fourth moment: 0.80 of nu Lap v on the same lattice),
-          Monaghan 1992 artificial viscosity
-          Pi_ij = (-alpha c_bar mu_ij + beta mu_ij^2)/rho_bar, mu_ij = h v_ij.x_ij/(r^2+eta^2) when
-          v_ij.x_ij < 0, gravity. [m/s^2]
+   PRESSURE: sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W_ij (seed 000 sec. 2.2.1), or the
+          multiphase form (p_i + p_j)/(rho_i rho_j) (Ott & Schnetter eq. 12); a wall particle is a
+          particle of mass psi_ib with the pressure and density of the chosen boundary scheme
+          (extrapolated; mirrored p_b = p_i, rho_b = rho_i; or p_b = 0). [m/s^2]
+   VISCOUS: laminar viscosity (Morris et al. 1997: sum_j m_j (mu_i + mu_j)/(rho_i rho_j)
+          x_ij.grad W_ij/(r^2+eta^2) v_ij, which needs only the second moment of grad W to give
+          nu Lap v, 0.96 of it on a lattice with Wendland C2 at h = 1.3 dx; or Monaghan 2005 /
+          seed 000 eq. 2.5, 2(d+2) sum_j m_j nu_bar/rho_bar v_ij.x_ij/(r^2+eta^2) grad W, which
+          conserves angular momentum but needs the fourth moment: 0.80 of nu Lap v on the same
+          lattice) and Monaghan 1992 artificial viscosity Pi_ij = (-alpha c_bar mu_ij +
+          beta mu_ij^2)/rho_bar, mu_ij = h v_ij.x_ij/(r^2+eta^2) when v_ij.x_ij < 0. [m/s^2]
    RATE:  continuity d rho_i/dt = sum_j m_j v_ij . grad W_ij (seed 000 eq. 2.2), or m_i in place
           of m_j (Ott & Schnetter eq. 11), plus delta-SPH diffusion (Molteni & Colagrossi 2009,
           seed 000 sec. 3.2.1) written with densities relative to each phase's rest density:
           delta h c0 sum_j 2 rho0_i V_j (rho_i/rho0_i - rho_j/rho0_j) x_ij.grad W_ij/(r^2+eta^2),
           which is seed 000's term for one phase and does not diffuse across a phase interface.
-          [kg/m^3/s] */
+          Walls enter with their own velocity (a moving wall compresses). [kg/m^3/s] */
 SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, const int flags,
                                    sph_real* acc, sph_real* rate) {
     const sph_real* xi = c->x + i * (size_t)D;
@@ -2396,25 +2602,27 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
         const size_t j = c->ff->idx[kk];
         const sph_real* xj = c->x + j * (size_t)D;
         const sph_real* vj = c->v + j * (size_t)D;
-        const sph__phase_c* Pj = &c->pc[c->ph[j]];
         const sph_real mj = c->m ? c->m[j] : c->m0, rhoj = c->rho[j];
-        sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, fw;
+        const sph__phase_c* Pj = (flags & (SPH__VISCOUS | SPH__RATE)) ? &c->pc[c->ph[j]] : P;
+        sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, fw, s = 0;
         sph__delta_vec(c, xi, xj, d, D);
-        for (k = 0; k < D; ++k) {
-            r2 += d[k] * d[k];
-            vd += (vi[k] - vj[k]) * d[k];
-        }
-        fw = c->k.norm_g * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h); /* grad W = fw d */
+        for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+        if (flags & (SPH__VISCOUS | SPH__RATE))
+            for (k = 0; k < D; ++k) vd += (vi[k] - vj[k]) * d[k];
+        if (flags & SPH__CACHED) fw = c->ff_fw[kk]; /* grad W = fw d */
+        else fw = c->k.norm_g * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h);
         if (flags & SPH__RATE) {
             R += (os ? mi : mj) * fw * vd;
             if (c->delta_on)
                 R += dcoef * (mj / rhoj) * (rhati - rhoj * Pj->inv_rho0) * fw * r2 / (r2 + c->eta2);
         }
-        if (flags & SPH__ACCEL) {
+        if (flags & SPH__PRESSURE) {
             const sph_real pj = c->p[j];
-            sph_real s;
-            if (c->pgrad == SPH_PGRAD_SYMMETRIC) s = -mj * (pi_r2 + pj / (rhoj * rhoj));
+            if (c->pgrad == SPH_PGRAD_SYMMETRIC)
+                s = -mj * (pi_r2 + ((flags & SPH__CACHED) ? c->pr2[j] : pj / (rhoj * rhoj)));
             else s = -mj * (pi + pj) * inv_rhoi / rhoj;
+        }
+        if (flags & SPH__VISCOUS) {
             if (c->laminar) {
                 const sph_real lv = c->visc_k * mj * (P->mu + Pj->mu) * inv_rhoi / rhoj / (r2 + c->eta2);
                 if (c->morris) /* along v_ij: x_ij . grad W = fw r^2 */
@@ -2427,6 +2635,8 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
                 const sph_real cbar = SPH__R(0.5) * (P->c0 + Pj->c0);
                 s -= mj * (-c->alpha * cbar * mu + c->beta * mu * mu) * 2 / (rhoi + rhoj);
             }
+        }
+        if (flags & SPH__ACCEL) {
             s *= fw;
             for (k = 0; k < D; ++k) ai[k] += s * d[k];
         }
@@ -2437,53 +2647,63 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
         for (kk = k0; kk < k1; ++kk) {
             const size_t b = c->fb->idx[kk];
             const sph_real* xb = c->bx + b * (size_t)D;
-            const sph_real Vb = c->bvol[b], psi = P->rho0 * Vb, kap = c->brho[b];
+            const sph_real Vb = c->bvol[b], psi = P->rho0 * Vb;
+            /* the wall's density and pressure as the boundary scheme gives them */
+            const sph_real kap = c->bp_mode == SPH_BP_EXTRAPOLATE ? c->brho[b] : rhati;
             const sph_real rhob = P->rho0 * kap;
-            sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, fw;
+            sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, fw, s = 0;
             sph__delta_vec(c, xi, xb, d, D);
-            for (k = 0; k < D; ++k) {
-                r2 += d[k] * d[k];
-                vd += (vi[k] - c->bv[b * (size_t)D + (size_t)k]) * d[k];
-            }
-            fw = c->k.norm_g * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h);
+            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+            if (flags & SPH__RATE)
+                for (k = 0; k < D; ++k) vd += (vi[k] - c->bv[b * (size_t)D + (size_t)k]) * d[k];
+            if (flags & SPH__CACHED) fw = c->fb_fw[kk];
+            else fw = c->k.norm_g * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h);
             if (flags & SPH__RATE) {
                 R += psi * fw * vd; /* the wall's own velocity: a moving wall compresses */
                 if (c->delta_on) R += dcoef * Vb * (rhati - kap) * fw * r2 / (r2 + c->eta2);
             }
-            if (flags & SPH__ACCEL) {
-                const sph_real pb = c->bp[b];
-                sph_real s;
+            if (flags & SPH__PRESSURE) {
+                const sph_real pb = c->bp_mode == SPH_BP_EXTRAPOLATE ? c->bp[b]
+                                    : c->bp_mode == SPH_BP_MIRROR    ? pi
+                                                                     : 0;
                 if (c->pgrad == SPH_PGRAD_SYMMETRIC) s = -psi * (pi_r2 + pb / (rhob * rhob));
                 else s = -psi * (pi + pb) * inv_rhoi / rhob;
-                if (c->noslip && (c->laminar || c->av)) {
-                    sph_real vg = 0;
-                    for (k = 0; k < D; ++k) vg += (vi[k] - c->bvw[b * (size_t)D + (size_t)k]) * d[k];
-                    if (c->laminar) {
-                        const sph_real lv = c->visc_k * psi * 2 * P->mu * inv_rhoi / rhob / (r2 + c->eta2);
-                        if (c->morris)
-                            for (k = 0; k < D; ++k)
-                                ai[k] += lv * fw * r2 * (vi[k] - c->bvw[b * (size_t)D + (size_t)k]);
-                        else
-                            s += lv * vg;
-                    }
-                    if (c->av && vg < 0) {
-                        const sph_real mu = c->h * vg / (r2 + c->eta2);
-                        s -= psi * (-c->alpha * P->c0 * mu + c->beta * mu * mu) * 2 / (rhoi + rhob);
-                    }
+            }
+            if ((flags & SPH__VISCOUS) && c->noslip && (c->laminar || c->av)) {
+                sph_real vg = 0;
+                for (k = 0; k < D; ++k) vg += (vi[k] - c->bvw[b * (size_t)D + (size_t)k]) * d[k];
+                if (c->laminar) {
+                    const sph_real lv = c->visc_k * psi * 2 * P->mu * inv_rhoi / rhob / (r2 + c->eta2);
+                    if (c->morris)
+                        for (k = 0; k < D; ++k)
+                            ai[k] += lv * fw * r2 * (vi[k] - c->bvw[b * (size_t)D + (size_t)k]);
+                    else
+                        s += lv * vg;
                 }
+                if (c->av && vg < 0) {
+                    const sph_real mu = c->h * vg / (r2 + c->eta2);
+                    s -= psi * (-c->alpha * P->c0 * mu + c->beta * mu * mu) * 2 / (rhoi + rhob);
+                }
+            }
+            if (flags & SPH__ACCEL) {
                 s *= fw;
                 for (k = 0; k < D; ++k) ai[k] += s * d[k];
             }
         }
     }
-    if (flags & SPH__ACCEL) /* acc holds the body acceleration already */
+    if (flags & SPH__SET)
+        for (k = 0; k < D; ++k) acc[i * (size_t)D + (size_t)k] = ai[k];
+    else if (flags & SPH__ACCEL) /* acc holds the body acceleration already */
         for (k = 0; k < D; ++k) acc[i * (size_t)D + (size_t)k] += ai[k];
     if (flags & SPH__RATE) rate[i] = R;
 }
 
 #define SPH__BLOCK 256 /* particles per parallel work item (and per force-callback call) */
 
-static void sph__stage_interact(sph_world* w, const sph__ctx* c, int flags) {
+/* Runs the neighbour loop over all fluid particles; accelerations go to acc (w->a, or solver
+   scratch), the density rate to w->drho. The loop is specialised per dimension and per kind
+   of pass, so each pass pays only for the terms it computes. */
+static void sph__stage_interact(sph_world* w, const sph__ctx* c, int flags, sph_real* acc) {
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
     sph__idx blk;
     SPH__OMP_FOR(w->n) /* over blocks of SPH__BLOCK particles */
@@ -2491,16 +2711,20 @@ static void sph__stage_interact(sph_world* w, const sph__ctx* c, int flags) {
         const size_t i0 = (size_t)blk * SPH__BLOCK;
         const size_t i1 = i0 + SPH__BLOCK < w->n ? i0 + SPH__BLOCK : w->n;
         size_t i;
-#define SPH__LOOP(D, FL) for (i = i0; i < i1; ++i) sph__interact_one(c, i, D, FL, w->a, w->drho)
-        switch (c->dim * 4 + flags) {
-        case 1 * 4 + SPH__ACCEL: SPH__LOOP(1, SPH__ACCEL); break;
-        case 1 * 4 + SPH__RATE: SPH__LOOP(1, SPH__RATE); break;
-        case 2 * 4 + SPH__ACCEL: SPH__LOOP(2, SPH__ACCEL); break;
-        case 2 * 4 + SPH__RATE: SPH__LOOP(2, SPH__RATE); break;
-        case 3 * 4 + SPH__ACCEL: SPH__LOOP(3, SPH__ACCEL); break;
-        case 3 * 4 + SPH__RATE: SPH__LOOP(3, SPH__RATE); break;
+#define SPH__LOOP(D, FL) for (i = i0; i < i1; ++i) sph__interact_one(c, i, D, FL, acc, w->drho)
+#define SPH__CASES(D)                                                                              \
+    case D * 32 + SPH__ACCEL: SPH__LOOP(D, SPH__ACCEL); break;                                     \
+    case D * 32 + SPH__VISCOUS: SPH__LOOP(D, SPH__VISCOUS); break;                                 \
+    case D * 32 + (SPH__PRESSURE | SPH__SET | SPH__CACHED):                                          \
+        SPH__LOOP(D, SPH__PRESSURE | SPH__SET | SPH__CACHED); break;                               \
+    case D * 32 + SPH__RATE: SPH__LOOP(D, SPH__RATE); break;
+        switch (c->dim * 32 + flags) {
+            SPH__CASES(1)
+            SPH__CASES(2)
+            SPH__CASES(3)
         default: SPH_ASSERT(0); break;
         }
+#undef SPH__CASES
 #undef SPH__LOOP
     }
 }
@@ -2574,12 +2798,12 @@ static sph_status sph__boundary_motion(sph_world* w, double t) {
 /* Integration update v += kv a, rho += kr drho, x += kx v (in that order), periodic wrap. With
    `final`, also the step's diagnostics and blow-up detection. Reductions run over fixed blocks
    combined in block order, so the result does not depend on the number of threads. */
-enum { SPH__RED_KE, SPH__RED_ERRSUM, SPH__RED_ERRMAX, SPH__RED_V2MAX, SPH__RED_A2MAX,
-       SPH__RED_OUT, SPH__RED_BAD, SPH__RED_KIND, SPH__RED_N };
+enum { SPH__RED_KE, SPH__RED_ERRSUM, SPH__RED_ERRMAX, SPH__RED_COMP, SPH__RED_V2MAX,
+       SPH__RED_A2MAX, SPH__RED_OUT, SPH__RED_BAD, SPH__RED_KIND, SPH__RED_N };
 enum { SPH__BAD_NONE, SPH__BAD_NONFINITE, SPH__BAD_DENSITY, SPH__BAD_COMPRESSION, SPH__BAD_SPEED };
 
-static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, sph_real kr,
-                                 sph_real kx, int final) {
+static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph_real* acc,
+                                      sph_real kv, sph_real kr, sph_real kx, int final) {
     const int D = w->dim;
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
     sph_real vlim = w->def.max_speed;
@@ -2609,7 +2833,7 @@ static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, s
         for (i = i0; i < i1; ++i) {
             sph_real* xi = w->x + i * (size_t)D;
             sph_real* vi = w->v + i * (size_t)D;
-            const sph_real* ai = w->a + i * (size_t)D;
+            const sph_real* ai = acc + i * (size_t)D;
             double v2 = 0, a2 = 0, err, mi;
             int out = 0, bad = SPH__BAD_NONE;
             if (kv != 0) for (kk = 0; kk < D; ++kk) vi[kk] += kv * ai[kk];
@@ -2641,6 +2865,7 @@ static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, s
             else if (vlim > 0 && v2 > (double)vlim * (double)vlim) bad = SPH__BAD_SPEED;
             r[SPH__RED_KE] += 0.5 * mi * v2;
             r[SPH__RED_ERRSUM] += fabs(err);
+            if (err > 0) r[SPH__RED_COMP] += err;
             if (fabs(err) > r[SPH__RED_ERRMAX]) r[SPH__RED_ERRMAX] = fabs(err);
             if (v2 > r[SPH__RED_V2MAX]) r[SPH__RED_V2MAX] = v2;
             if (a2 > r[SPH__RED_A2MAX]) r[SPH__RED_A2MAX] = a2;
@@ -2658,6 +2883,7 @@ static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, s
         const double* r = w->priv.block + q * SPH__RED_N;
         red[SPH__RED_KE] += r[SPH__RED_KE];
         red[SPH__RED_ERRSUM] += r[SPH__RED_ERRSUM];
+        red[SPH__RED_COMP] += r[SPH__RED_COMP];
         if (r[SPH__RED_ERRMAX] > red[SPH__RED_ERRMAX]) red[SPH__RED_ERRMAX] = r[SPH__RED_ERRMAX];
         if (r[SPH__RED_V2MAX] > red[SPH__RED_V2MAX]) red[SPH__RED_V2MAX] = r[SPH__RED_V2MAX];
         if (r[SPH__RED_A2MAX] > red[SPH__RED_A2MAX]) red[SPH__RED_A2MAX] = r[SPH__RED_A2MAX];
@@ -2670,6 +2896,7 @@ static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, s
     w->stats.kinetic_energy = red[SPH__RED_KE];
     w->stats.density_error_avg = w->n ? red[SPH__RED_ERRSUM] / (double)w->n : 0;
     w->stats.density_error_max = red[SPH__RED_ERRMAX];
+    w->stats.compression_avg = w->n ? red[SPH__RED_COMP] / (double)w->n : 0;
     w->stats.v_max = sqrt(red[SPH__RED_V2MAX]);
     w->stats.a_max = sqrt(red[SPH__RED_A2MAX]);
     w->stats.n_outside = (size_t)red[SPH__RED_OUT];
@@ -2707,6 +2934,11 @@ static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, s
     return SPH_OK;
 }
 
+static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, sph_real kr,
+                                 sph_real kx, int final) {
+    return sph__integrate_with(w, c, w->a, kv, kr, kx, final);
+}
+
 /* Common start of every step: input checks, automatic sound speeds, stats reset. */
 static sph_status sph__step_begin(sph_world* w, sph_real dt) {
     sph_status s;
@@ -2715,7 +2947,13 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt) {
     s = sph__check_step_input(w, dt);
     if (s != SPH_OK) return s;
     s = sph__resolve_sound_speed(w);
-    if (s != SPH_OK) return s;
+    if (s != SPH_OK) {
+        /* an incompressible solver uses c0 only to scale artificial viscosity and the speed
+           bound of the blow-up check: without one, both are off */
+        if (w->def.solver == SPH_SOLVER_WCSPH) return s;
+        w->status = SPH_OK;
+        w->error[0] = 0;
+    }
     for (k = 0; k < SPH_STAGE_COUNT; ++k) w->stats.stage_time[k] = 0;
     w->stats.step_time = 0;
     w->stats.dt = (double)dt;
@@ -2744,7 +2982,7 @@ static sph_status sph__prepare_forces(sph_world* w, sph__ctx* c, double t, doubl
     sph__time(w, SPH_STAGE_PRESSURE, t0);
     sph__stage_body_force(w, c);
     sph__time(w, SPH_STAGE_FORCES, t0);
-    if (w->nb > 0) sph__stage_wall_pressure(w, c);
+    if (w->nb > 0) sph__stage_wall(w, c, SPH__WALL_STATE | SPH__WALL_PRESSURE);
     sph__time(w, SPH_STAGE_PRESSURE, t0);
     return SPH_OK;
 }
@@ -2777,12 +3015,12 @@ static sph_status sph__step_wcsph_euler(sph_world* w, sph_real dt) {
     sph__ctx c;
     sph_status s = sph__prepare_forces(w, &c, w->time, &t0);
     if (s != SPH_OK) return s;
-    sph__stage_interact(w, &c, SPH__ACCEL);
+    sph__stage_interact(w, &c, SPH__ACCEL, w->a);
     sph__time(w, SPH_STAGE_FORCES, &t0);
     s = sph__integrate(w, &c, dt, 0, 0, 0); /* kick */
     if (s != SPH_OK) return s;
     if (cont) {
-        sph__stage_interact(w, &c, SPH__RATE);
+        sph__stage_interact(w, &c, SPH__RATE, NULL);
         sph__time(w, SPH_STAGE_DENSITY, &t0);
     }
     ++w->steps;
@@ -2829,14 +3067,14 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
     sph__time(w, SPH_STAGE_PRESSURE, &t0);
     sph__stage_body_force(w, &c);
     sph__time(w, SPH_STAGE_FORCES, &t0);
-    if (w->nb > 0) sph__stage_wall_pressure(w, &c);
+    if (w->nb > 0) sph__stage_wall(w, &c, SPH__WALL_STATE | SPH__WALL_PRESSURE);
     sph__time(w, SPH_STAGE_PRESSURE, &t0);
-    sph__stage_interact(w, &c, SPH__ACCEL);
+    sph__stage_interact(w, &c, SPH__ACCEL, w->a);
     sph__time(w, SPH_STAGE_FORCES, &t0);
     s = sph__integrate(w, &c, half, 0, 0, 0); /* half kick: v = (v^n + v^{n+1}) / 2 */
     if (s != SPH_OK) return s;
     if (cont) {
-        sph__stage_interact(w, &c, SPH__RATE);
+        sph__stage_interact(w, &c, SPH__RATE, NULL);
         SPH__OMP_FOR(w->n)
         for (i = 0; i < (sph__idx)w->n; ++i) w->rho[i] = w->priv.rho_n[i] + dt * w->drho[i];
         sph__time(w, SPH_STAGE_DENSITY, &t0);
@@ -2864,19 +3102,259 @@ SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt) {
     return sph__step_end(w, sph__step_wcsph_euler(w, dt));
 }
 
+/* ============================================================================================== */
+/* >>iisph (implementation)                                                                       */
+/* ============================================================================================== */
+/* Implicit incompressible SPH, Ihmsen et al. 2014 in the form of Koschier et al. 2020 and seed 003
+   (Alg. 1-2), with the thesis' errata and the reference code's bugs fixed (digest sec. 6, 8):
+     rho_i   summation density at x^n (walls as psi = rho0_i V_b; all density sums below are
+             divided by the kernel's lattice sum S, as the summation density is);
+     v*      = v^n + dt a_np, a_np = gravity + user forces + viscosity;
+     rho*_i  = rho_i + dt sum_j m_j (v*_i - v*_j).grad W_ij + dt sum_b psi_ib (v*_i - v_b).grad W_ib
+               (the wall's velocity enters: a moving wall compresses; the reference code left it out)
+     solve   (A p)_i = s_i = rho0_i - rho*_i with
+             (A p)_i = dt^2 [sum_j m_j (a^p_i - a^p_j).grad W_ij + sum_b psi_ib a^p_i.grad W_ib],
+             a^p the pressure acceleration of the boundary scheme, by relaxed Jacobi
+             p_i <- max(0, p_i + omega (s_i - (A p)_i) / a_ii)  (negative pressure clamped),
+             starting from warm_start * p of the last step;
+     stop    when the mean predicted compression max(0, ((A p)_i - s_i)/rho0_i) <= tolerance,
+             after min_iterations and at most max_iterations;
+     move    v = v* + dt a^p(p_final), x += dt v: the last update is applied (the thesis'
+             algorithm moves with the pressure before the last update).
+   The diagonal is exact for the operator above (digest sec. 2.3 generalised to unequal masses):
+     a_ii = dt^2 [ -(sum_j m_j gW_ij + sum_b psi_ib (1 + k_b rho_i^2/rho_b^2) gW_ib)
+                    . (sum_j m_j gW_ij + sum_b psi_ib gW_ib) / rho_i^2 - m_i/rho_i^2 sum_j m_j |gW_ij|^2 ]
+   with k_b = d p_b / d p_i: 0 for zero pressure, 1 for mirroring, W_bi / sum_f W_bf for
+   extrapolation. a_ii < 0; a particle without neighbours has a_ii = 0 and gets p = 0. */
+
+/* Diagonal and source term of fluid particle i (one neighbour pass). */
+SPH__INLINE void sph__iisph_prepare_one(const sph_world* w, const sph__ctx* c, size_t i, const int D,
+                                        sph_real dt) {
+    const sph_real* xi = c->x + i * (size_t)D;
+    const sph_real* vi = c->v + i * (size_t)D;
+    const sph__phase_c* P = &c->pc[c->ph[i]];
+    const sph_real rhoi = c->rho[i], mi = c->m ? c->m[i] : c->m0, inv_r2 = 1 / (rhoi * rhoi);
+    sph_real A[3] = {0, 0, 0}, dv[3] = {0, 0, 0}, Q = 0, R = 0, dot = 0;
+    size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
+    int k;
+    for (kk = k0; kk < k1; ++kk) {
+        const size_t j = c->ff->idx[kk];
+        const sph_real mj = c->m ? c->m[j] : c->m0;
+        sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, fw;
+        sph__delta_vec(c, xi, c->x + j * (size_t)D, d, D);
+        for (k = 0; k < D; ++k) {
+            r2 += d[k] * d[k];
+            vd += (vi[k] - c->v[j * (size_t)D + (size_t)k]) * d[k];
+        }
+        fw = c->k.norm_g * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h);
+        w->priv.ff_fw[kk] = fw; /* reused by every iteration */
+        for (k = 0; k < D; ++k) { A[k] += mj * fw * d[k]; dv[k] += mj * fw * d[k]; }
+        Q += mj * fw * fw * r2;
+        R += mj * fw * vd;
+    }
+    if (c->has_b) {
+        k0 = c->fb->begin[i];
+        k1 = k0 + c->fb->count[i];
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t b = c->fb->idx[kk];
+            const sph_real psi = P->rho0 * c->bvol[b];
+            sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, fw, kb = 0, q;
+            sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
+            for (k = 0; k < D; ++k) {
+                r2 += d[k] * d[k];
+                vd += (vi[k] - c->bv[b * (size_t)D + (size_t)k]) * d[k];
+            }
+            q = sph__sqrt(r2) * c->k.inv_h;
+            fw = c->k.norm_g * sph__kf(c->k.form, q);
+            w->priv.fb_fw[kk] = fw;
+            if (c->bp_mode == SPH_BP_MIRROR) kb = 1;
+            else if (c->bp_mode == SPH_BP_EXTRAPOLATE && w->priv.b_sw[b] > 0) {
+                const sph_real rb = P->rho0 * c->brho[b];
+                kb = sph__kw(c->k.form, q) / w->priv.b_sw[b] * rhoi * rhoi / (rb * rb);
+            }
+            for (k = 0; k < D; ++k) {
+                A[k] += psi * fw * d[k];
+                dv[k] += psi * (1 + kb) * fw * d[k];
+            }
+            R += psi * fw * vd;
+        }
+    }
+    for (k = 0; k < D; ++k) dot += dv[k] * A[k];
+    /* density sums are normalised by the lattice sum S (sph__stage_density_summation), so are
+       their rates of change */
+    w->priv.aii[i] = dt * dt * (-dot * inv_r2 - mi * inv_r2 * Q) / w->priv.lattice_sum;
+    w->priv.src[i] = P->rho0 - (rhoi + dt * R / w->priv.lattice_sum);
+}
+
+/* (A p)_i from the pressure accelerations, the Jacobi update of p_i (in place: A p reads only
+   accelerations) and the predicted compression before the update. */
+SPH__INLINE double sph__iisph_update_one(sph_world* w, const sph__ctx* c, size_t i, const int D,
+                                         sph_real dt, sph_real omega) {
+    const sph_real* xi = c->x + i * (size_t)D;
+    const sph_real* api = w->priv.ap + i * (size_t)D;
+    const sph__phase_c* P = &c->pc[c->ph[i]];
+    sph_real Ap = 0, sb[3] = {0, 0, 0}, aii = w->priv.aii[i], err, p;
+    size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
+    int k;
+    for (kk = k0; kk < k1; ++kk) {
+        const size_t j = c->ff->idx[kk];
+        const sph_real* apj = w->priv.ap + j * (size_t)D;
+        const sph_real mj = c->m ? c->m[j] : c->m0;
+        sph_real d[3] = {0, 0, 0}, dd = 0;
+        sph__delta_vec(c, xi, c->x + j * (size_t)D, d, D);
+        for (k = 0; k < D; ++k) dd += (api[k] - apj[k]) * d[k];
+        Ap += mj * w->priv.ff_fw[kk] * dd;
+    }
+    if (c->has_b) {
+        k0 = c->fb->begin[i];
+        k1 = k0 + c->fb->count[i];
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t b = c->fb->idx[kk];
+            sph_real d[3] = {0, 0, 0};
+            const sph_real fw = w->priv.fb_fw[kk] * P->rho0 * c->bvol[b];
+            sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
+            for (k = 0; k < D; ++k) sb[k] += fw * d[k];
+        }
+        for (k = 0; k < D; ++k) Ap += api[k] * sb[k];
+    }
+    Ap *= dt * dt / w->priv.lattice_sum;
+    err = (Ap - w->priv.src[i]) * P->inv_rho0;
+    p = aii < 0 ? w->p[i] + omega * (w->priv.src[i] - Ap) / aii : 0;
+    w->p[i] = p > 0 ? p : 0;
+    return err > 0 ? (double)err : 0.0;
+}
+
+/* One Jacobi sweep over all particles; returns the mean predicted compression (fixed-order block
+   sums, so the iteration count does not depend on the thread count). */
+static double sph__iisph_sweep(sph_world* w, const sph__ctx* c, sph_real dt) {
+    const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
+    const sph_real omega = w->def.omega;
+    double sum = 0;
+    sph__idx blk;
+    size_t q;
+    SPH__OMP_FOR(w->n) /* over blocks of SPH__BLOCK particles */
+    for (blk = 0; blk < (sph__idx)nblk; ++blk) {
+        const size_t i0 = (size_t)blk * SPH__BLOCK;
+        const size_t i1 = i0 + SPH__BLOCK < w->n ? i0 + SPH__BLOCK : w->n;
+        double e = 0;
+        size_t i;
+        if (c->dim == 2) for (i = i0; i < i1; ++i) e += sph__iisph_update_one(w, c, i, 2, dt, omega);
+        else if (c->dim == 3) for (i = i0; i < i1; ++i) e += sph__iisph_update_one(w, c, i, 3, dt, omega);
+        else for (i = i0; i < i1; ++i) e += sph__iisph_update_one(w, c, i, 1, dt, omega);
+        w->priv.block[blk] = e;
+    }
+    for (q = 0; q < nblk; ++q) sum += w->priv.block[q];
+    return w->n ? sum / (double)w->n : 0;
+}
+
+/* a^p from the current pressures: wall pressures (extrapolation), p / rho^2, one cached pass. */
+static void sph__iisph_pressure_acceleration(sph_world* w, const sph__ctx* c) {
+    sph__idx i;
+    if (w->nb > 0) sph__stage_wall(w, c, SPH__WALL_PRESSURE);
+    SPH__OMP_FOR(w->n)
+    for (i = 0; i < (sph__idx)w->n; ++i) w->priv.pr2[i] = w->p[i] / (w->rho[i] * w->rho[i]);
+    sph__stage_interact(w, c, SPH__PRESSURE | SPH__SET | SPH__CACHED, w->priv.ap);
+}
+
+static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
+    const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
+    double t0 = sph__now(), tstart = t0, err = 0;
+    sph__ctx c;
+    sph_status s;
+    sph__idx i;
+    int it = 0;
+    if ((s = sph__scratch(w, &w->priv.aii, w->capacity)) != SPH_OK ||
+        (s = sph__scratch(w, &w->priv.src, w->capacity)) != SPH_OK ||
+        (s = sph__scratch(w, &w->priv.ap, w->capacity * (size_t)w->dim)) != SPH_OK)
+        return s;
+    if (nblk > w->priv.block_cap) {
+        if (!sph__grow((void**)&w->priv.block, nblk + 64, sizeof(double)))
+            return sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory (reduction blocks)");
+        w->priv.block_cap = nblk + 64;
+    }
+    s = sph__boundary_motion(w, w->time);
+    if (s != SPH_OK) return s;
+    sph__time(w, SPH_STAGE_BOUNDARY, &t0);
+    s = sph__stage_neighbors(w);
+    if (s != SPH_OK) return s;
+    if ((s = sph__scratch(w, &w->priv.ff_fw, w->priv.ff.cap_idx)) != SPH_OK ||
+        (s = sph__scratch(w, &w->priv.fb_fw, w->priv.fb.cap_idx)) != SPH_OK ||
+        (s = sph__scratch(w, &w->priv.pr2, w->capacity)) != SPH_OK)
+        return s;
+    sph__ctx_init(w, &c);
+    c.ff_fw = w->priv.ff_fw;
+    c.fb_fw = w->priv.fb_fw;
+    c.pr2 = w->priv.pr2;
+    c.delta_on = 0;          /* the density is a summation, no diffusion */
+    c.density = SPH_DENSITY_CONTINUITY;
+    sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
+    sph__stage_density_summation(w, &c);
+    sph__time(w, SPH_STAGE_DENSITY, &t0);
+    /* non-pressure accelerations and the predicted velocity v* (kept in w->v) */
+    sph__stage_body_force(w, &c);
+    if (w->nb > 0) sph__stage_wall(w, &c, SPH__WALL_STATE);
+    if (c.laminar || c.av) sph__stage_interact(w, &c, SPH__VISCOUS, w->a);
+    s = sph__integrate(w, &c, dt, 0, 0, 0);
+    if (s != SPH_OK) return s;
+    sph__time(w, SPH_STAGE_FORCES, &t0);
+    /* diagonal, source, warm start */
+    SPH__OMP_FOR(w->n)
+    for (i = 0; i < (sph__idx)w->n; ++i) {
+        if (c.dim == 2) sph__iisph_prepare_one(w, &c, (size_t)i, 2, dt);
+        else if (c.dim == 3) sph__iisph_prepare_one(w, &c, (size_t)i, 3, dt);
+        else sph__iisph_prepare_one(w, &c, (size_t)i, 1, dt);
+        w->p[i] = w->p[i] > 0 ? w->def.warm_start * w->p[i] : 0;
+    }
+    /* relaxed Jacobi on the pressure */
+    for (;;) {
+        sph__iisph_pressure_acceleration(w, &c);
+        err = sph__iisph_sweep(w, &c, dt);
+        ++it;
+        if ((it >= w->def.min_iterations && err <= (double)w->def.tolerance) ||
+            it >= w->def.max_iterations)
+            break;
+    }
+    /* the motion uses the final pressure */
+    sph__iisph_pressure_acceleration(w, &c);
+    sph__time(w, SPH_STAGE_PRESSURE, &t0);
+    SPH__OMP_FOR(w->n)
+    for (i = 0; i < (sph__idx)(w->n * (size_t)w->dim); ++i) {
+        w->v[i] += dt * w->priv.ap[i];
+        w->a[i] += w->priv.ap[i]; /* total acceleration, for the diagnostics */
+    }
+    w->stats.iterations = it;
+    w->stats.solver_error = err;
+    ++w->steps;
+    w->time += (double)dt;
+    s = sph__integrate(w, &c, 0, 0, dt, 1);
+    sph__time(w, SPH_STAGE_INTEGRATE, &t0);
+    w->stats.step_time = sph__now() - tstart;
+    return s;
+}
+
+SPHDEF sph_status sph_step_iisph(sph_world* w, sph_real dt) {
+    sph_status s = sph__step_begin(w, dt);
+    if (s != SPH_OK) return s;
+    return sph__step_end(w, sph__step_iisph(w, dt));
+}
+
 /* >>stages: time step control */
 
 SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
     const size_t D = w ? (size_t)w->dim : 0;
-    double cmax = 0, numax = 0, v2max = 0, amax, dt, g2 = 0;
+    double cmax = 0, numax = 0, v2max = 0, amax, dt = 1e300, g2 = 0;
     size_t i, k;
     int q;
     if (!w) return 0;
-    if (solver != SPH_SOLVER_WCSPH) {
+    if ((int)solver < 0 || solver > SPH_SOLVER_IISPH) {
         sph__fail(w, SPH_ERR_ARG, -1, "sph_stable_dt: solver %d is not a sph_solver", (int)solver);
         return 0;
     }
-    if (sph__resolve_sound_speed(w) != SPH_OK) return 0;
+    if (sph__resolve_sound_speed(w) != SPH_OK) {
+        if (solver == SPH_SOLVER_WCSPH) return 0;
+        w->status = SPH_OK; /* incompressible solvers do not need c0 */
+        w->error[0] = 0;
+    }
     for (q = 0; q < w->nphase; ++q) {
         if ((double)w->phases[q].sound_speed > cmax) cmax = (double)w->phases[q].sound_speed;
         if ((double)w->phases[q].viscosity > numax) numax = (double)w->phases[q].viscosity;
@@ -2893,11 +3371,15 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
     }
     for (k = 0; k < D; ++k) g2 += (double)w->def.gravity[k] * (double)w->def.gravity[k];
     amax = w->steps > 0 ? w->stats.a_max : sqrt(g2);
-    if (!(cmax > 0)) {
-        sph__fail(w, SPH_ERR_ARG, -1, "sph_stable_dt: no phase has a sound speed (add particles)");
-        return 0;
+    if (solver == SPH_SOLVER_WCSPH) {
+        if (!(cmax > 0)) {
+            sph__fail(w, SPH_ERR_ARG, -1, "sph_stable_dt: no phase has a sound speed (add particles)");
+            return 0;
+        }
+        dt = (double)w->def.cfl * (double)w->h / (cmax + sqrt(v2max));
+    } else if (v2max > 0) { /* seed 003 eq. 14: a particle moves at most cfl_velocity dx per step */
+        dt = (double)w->def.cfl_velocity * (double)w->dx / sqrt(v2max);
     }
-    dt = (double)w->def.cfl * (double)w->h / (cmax + sqrt(v2max));
     /* The explicit viscous step is stable while dt nu lambda_max <= 2. A Fourier analysis of the
        operators on a lattice (h = 1-2 dx, 2D and 3D) gives lambda_max = 2 / (C h^2 / nu) with
        C = 0.29-0.36 (Morris form, cubic and Wendland C2), 0.50 (quintic), but only C = 0.112-0.15
@@ -2907,6 +3389,11 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
         dt = fmin(dt, (double)w->def.cfl_viscous * (w->def.viscosity_form == SPH_VISC_MONAGHAN ? 0.8 : 1.0) *
                           (double)w->h * (double)w->h / numax);
     if (amax > 0) dt = fmin(dt, (double)w->def.cfl_force * sqrt((double)w->h / amax));
+    if (dt >= 1e300) {
+        sph__fail(w, SPH_ERR_ARG, -1, "sph_stable_dt: nothing limits the step (no motion, no force, "
+                                      "no viscosity); choose dt yourself");
+        return 0;
+    }
     return (sph_real)dt;
 }
 
@@ -2914,6 +3401,7 @@ SPHDEF sph_status sph_step(sph_world* w, sph_real dt) {
     if (!w) return SPH_ERR_ARG;
     switch (w->def.solver) {
     case SPH_SOLVER_WCSPH: return sph_step_wcsph(w, dt);
+    case SPH_SOLVER_IISPH: return sph_step_iisph(w, dt);
     default: return sph__fail(w, SPH_ERR_ARG, -1, "sph_step: unknown solver %d", (int)w->def.solver);
     }
 }

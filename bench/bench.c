@@ -1,7 +1,11 @@
-/* bench/bench.c - throughput of the WCSPH step on the shared scenes.
+/* bench/bench.c - throughput of the WCSPH step on the shared scenes, and IISPH's time-step sweep.
    Build: cc -O2 -fopenmp -I. bench/bench.c -o bench -lm
    Run:   ./bench [scene = dambreak2d] [particles per column width = 100] [steps = 200]
                   [repeats = 3] [csv file]
+          ./bench iisph-sweep [particles over the 0.5 m depth = 40] [csv file]
+   The sweep runs a hydrostatic tank (1 m wide, 0.5 m deep) with IISPH for one simulated second at
+   several time steps and reports, like seed 003's Table 2, the mean iterations, the time spent in
+   the pressure solve and in the neighbour search, and the overall time per simulated second.
    For each thread count from 1 to the number of processors it runs the scene's first `steps`
    steps (after 20 warm-up steps) `repeats` times and reports the median: fluid particle-steps
    per second, time per step and per stage, neighbour pairs per particle and bytes per particle
@@ -59,6 +63,48 @@ static int run_once(const char* scene, int res, int steps, bench_run* r) {
     return 1;
 }
 
+/* Seed 003 Table 2 for our solver: the time step against iterations and time to solution. */
+static int iisph_sweep(int res, const char* csv) {
+    /* in units of sqrt(dx / g); seed 003's Table 2 spans 0.0087-0.013 of its sqrt(h / g) */
+    static const double fs[] = {0.005, 0.0075, 0.01, 0.015, 0.02, 0.03, 0.05, 0.08};
+    const double dx = 0.5 / res, unit = sqrt(dx / 9.81);
+    FILE* f = csv ? fopen(csv, "w") : NULL;
+    size_t k;
+    if (f) fprintf(f, "dt,dt_units,steps,iterations,pressure_s,neighbors_s,overall_s\n");
+    printf("IISPH hydrostatic tank, %d particles deep, 1 s simulated, %d thread(s)\n", res,
+#ifdef _OPENMP
+           omp_get_max_threads()
+#else
+           1
+#endif
+    );
+    printf("%9s %15s %7s %10s %12s %13s %11s\n", "dt [s]", "dt/sqrt(dx/g)", "steps", "iterations",
+           "pressure [s]", "neighbors [s]", "overall [s]");
+    for (k = 0; k < sizeof(fs) / sizeof(fs[0]); ++k) {
+        const double dt = fs[k] * unit;
+        sph_world_def def = sph_world_def_default(2);
+        sph_world w;
+        double its = 0;
+        int steps = 0;
+        def.solver = SPH_SOLVER_IISPH;
+        if (scene_hydrostatic(&w, def, 1.0, 0.5, res) != SPH_OK) { fprintf(stderr, "%s\n", scene_error); return 1; }
+        while (w.time < 1.0 - 1e-9) {
+            if (sph_step(&w, (sph_real)dt) != SPH_OK) { fprintf(stderr, "%s\n", w.error); return 1; }
+            its += w.stats.iterations;
+            ++steps;
+        }
+        printf("%9.6f %15.4f %7d %10.1f %12.3f %13.3f %11.3f\n", dt, fs[k], steps, its / steps,
+               w.stage_time_total[SPH_STAGE_PRESSURE], w.stage_time_total[SPH_STAGE_NEIGHBORS],
+               w.step_time_total);
+        if (f) fprintf(f, "%.6f,%.4f,%d,%.2f,%.4f,%.4f,%.4f\n", dt, fs[k], steps, its / steps,
+                       w.stage_time_total[SPH_STAGE_PRESSURE], w.stage_time_total[SPH_STAGE_NEIGHBORS],
+                       w.step_time_total);
+        sph_world_free(&w);
+    }
+    if (f) fclose(f);
+    return 0;
+}
+
 int main(int argc, char** argv) {
     const char* scene = argc > 1 ? argv[1] : "dambreak2d";
     const int res = argc > 2 ? atoi(argv[2]) : 100, steps = argc > 3 ? atoi(argv[3]) : 200;
@@ -69,6 +115,8 @@ int main(int argc, char** argv) {
     int maxthreads = 1, t, k, rep;
     double base = 0;
     FILE* f = NULL;
+    if (strcmp(scene, "iisph-sweep") == 0)
+        return iisph_sweep(argc > 2 ? atoi(argv[2]) : 40, argc > 3 ? argv[3] : NULL);
 #ifdef _OPENMP
     maxthreads = omp_get_num_procs();
 #endif

@@ -8,6 +8,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #if defined(__GNUC__) || defined(__clang__)
@@ -79,6 +80,132 @@ SCENE_FN sph_status scene_dam_break(sph_world* w, sph_world_def def, double a, i
     SCENE__TRY(sph_set_hydrostatic(w));
     if (out) { out->a = a; out->length = 5 * a; out->height = 3 * a; }
     return SPH_OK;
+}
+
+/* Stirrer after seed 003 sec. 5.1.2: an oval container (semi-axes 0.5 m x 0.35 m, one layer of
+   wall particles at spacing dx) holds water up to `fill` of its height, stirred by a rotor at the
+   centre: a hub of radius 0.06 m and three blades 0.2 m long whose particles are spaced
+   non-uniformly (from 0.5 dx at the hub to 1.0 dx at the tip), rotating at omega [rad/s].
+   Boundary volumes come from the particle density (SPH_BVOL_AKINCI). Body 0 is the container,
+   body 1 the rotor; the motion callback is scene_stirrer_motion with a scene_stirrer as user. */
+typedef struct scene_stirrer {
+    double omega;      /* rotor angular velocity [rad/s], counter-clockwise */
+    double cx, cy;     /* centre [m] */
+} scene_stirrer;
+
+SCENE_FN void scene_stirrer_motion(sph_world* w, double t, void* user) {
+    const scene_stirrer* s = (const scene_stirrer*)user;
+    const double c = cos(s->omega * t), sn = sin(s->omega * t), om = s->omega;
+    size_t b;
+    for (b = 0; b < w->nb; ++b) {
+        double rx, ry, x, y;
+        if (w->b_body[b] != 1) continue;
+        rx = (double)w->b_x0[2 * b] - s->cx;
+        ry = (double)w->b_x0[2 * b + 1] - s->cy;
+        x = c * rx - sn * ry;
+        y = sn * rx + c * ry;
+        w->b_x[2 * b] = (sph_real)(s->cx + x);
+        w->b_x[2 * b + 1] = (sph_real)(s->cy + y);
+        w->b_v[2 * b] = (sph_real)(-om * y); /* omega x r */
+        w->b_v[2 * b + 1] = (sph_real)(om * x);
+        w->b_a[2 * b] = (sph_real)(-om * om * x); /* centripetal */
+        w->b_a[2 * b + 1] = (sph_real)(-om * om * y);
+    }
+}
+
+SCENE_FN sph_status scene_stirrer_build(sph_world* w, sph_world_def def, double dx, double fill,
+                                        scene_stirrer* st) {
+    const double A = 0.5, B = 0.35, pi = 3.14159265358979323846, hub = 0.06, blade = 0.2;
+    sph_phase water;
+    sph_real* pts = NULL;
+    size_t n = 0, cap, k;
+    int ph, i, j, blade_i;
+    memset(&water, 0, sizeof(water));
+    water.rest_density = 1000;
+    def.spacing = (sph_real)dx;
+    def.boundary_volume = SPH_BVOL_AKINCI;
+    def.boundary_motion = scene_stirrer_motion;
+    def.boundary_user = st;
+    st->cx = A;
+    st->cy = B;
+    SCENE__TRY(sph_world_init(w, &def));
+    ph = sph_world_add_phase(w, &water);
+    if (ph < 0) return scene__fail(w, w->status);
+    cap = (size_t)(4 * pi * A / dx) + (size_t)(4 * (A / dx) * (B / dx)) + 4096;
+    pts = (sph_real*)malloc(cap * 2 * sizeof(sph_real));
+    if (!pts) return scene__fail(w, SPH_ERR_NOMEM);
+    { /* container: one layer, equal arc length along the ellipse (Ramanujan perimeter) */
+        const double h = (A - B) * (A - B) / ((A + B) * (A + B));
+        const double per = pi * (A + B) * (1 + 3 * h / (10 + sqrt(4 - 3 * h)));
+        const int m = (int)(per / dx + 0.5);
+        double th = 0;
+        for (i = 0; i < m; ++i) {
+            /* step the parameter so the arc length advances by per / m */
+            double ds = per / m, sp = sqrt(A * A * sin(th) * sin(th) + B * B * cos(th) * cos(th));
+            pts[2 * n] = (sph_real)(st->cx + A * cos(th));
+            pts[2 * n + 1] = (sph_real)(st->cy + B * sin(th));
+            ++n;
+            th += ds / sp;
+        }
+        if (sph_add_boundary(w, n, pts, NULL, 0) != SPH_OK) { free(pts); return scene__fail(w, w->status); }
+    }
+    n = 0;
+    { /* rotor: hub circle and three blades, spacing growing from 0.5 dx to dx */
+        const int m = (int)(2 * pi * hub / (0.5 * dx));
+        for (i = 0; i < m; ++i) {
+            pts[2 * n] = (sph_real)(st->cx + hub * cos(2 * pi * i / m));
+            pts[2 * n + 1] = (sph_real)(st->cy + hub * sin(2 * pi * i / m));
+            ++n;
+        }
+        for (blade_i = 0; blade_i < 3; ++blade_i) {
+            const double ang = 2 * pi * blade_i / 3;
+            double r = hub + 0.5 * dx;
+            while (r <= hub + blade) {
+                pts[2 * n] = (sph_real)(st->cx + r * cos(ang));
+                pts[2 * n + 1] = (sph_real)(st->cy + r * sin(ang));
+                ++n;
+                r += dx * (0.5 + 0.5 * (r - hub) / blade);
+            }
+        }
+        if (sph_add_boundary(w, n, pts, NULL, 1) != SPH_OK) { free(pts); return scene__fail(w, w->status); }
+    }
+    n = 0;
+    { /* water: lattice points inside the ellipse (a spacing from it), below the fill level,
+         a spacing away from the rotor's hub and blades */
+        for (i = 0; i < (int)(2 * A / dx); ++i)
+            for (j = 0; j < (int)(2 * B / dx); ++j) {
+                const double x = (i + 0.5) * dx, y = (j + 0.5) * dx;
+                const double ex = (x - st->cx) / (A - dx), ey = (y - st->cy) / (B - dx);
+                const double rx = x - st->cx, ry = y - st->cy, r = sqrt(rx * rx + ry * ry);
+                int near = r < hub + dx;
+                for (blade_i = 0; blade_i < 3 && !near; ++blade_i) {
+                    const double ang = 2 * pi * blade_i / 3, ux = cos(ang), uy = sin(ang);
+                    const double along = rx * ux + ry * uy, across = fabs(-rx * uy + ry * ux);
+                    if (along > 0 && along < hub + blade + dx && across < dx) near = 1;
+                }
+                if (ex * ex + ey * ey < 1 && y < 2 * B * fill && !near && n < cap) {
+                    pts[2 * n] = (sph_real)x;
+                    pts[2 * n + 1] = (sph_real)y;
+                    ++n;
+                }
+            }
+        if (sph_add_fluid(w, ph, n, pts, NULL) != SPH_OK) { free(pts); return scene__fail(w, w->status); }
+    }
+    free(pts);
+    (void)k;
+    return SPH_OK;
+}
+
+/* The largest value of (x/a)^2 + (y/b)^2 over fluid particles relative to the container's centre:
+   below 1 means every particle is inside the oval. */
+SCENE_FN double scene_stirrer_extent(const sph_world* w, const scene_stirrer* st) {
+    double worst = 0;
+    size_t i;
+    for (i = 0; i < w->n; ++i) {
+        const double ex = ((double)w->x[2 * i] - st->cx) / 0.5, ey = ((double)w->x[2 * i + 1] - st->cy) / 0.35;
+        if (ex * ex + ey * ey > worst) worst = ex * ex + ey * ey;
+    }
+    return worst;
 }
 
 /* Surge front: the largest x of fluid particles within 0.1 a of the floor, plus half a spacing

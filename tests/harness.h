@@ -6,7 +6,8 @@
        const th_test tests_area[] = { {"area/something", test_something}, {0, 0} };
 
    tests/main.c lists every table; `build/tests [filter...]` runs the tests whose name contains
-   any filter and ends with the line "N passed, N failed". TH_NOTE prints a measured number
+   any filter and ends with the line "N passed, N failed"; tables of long runs (make validate)
+   run only with --long. TH_NOTE prints a measured number
    (shown in the output so closing notes can quote it). TH_SKIP ends a test that cannot run in
    this build (e.g. determinism without OpenMP); skips are counted separately. */
 #ifndef SPH_TEST_HARNESS_H
@@ -25,6 +26,8 @@ extern const th_test tests_grid[];
 extern const th_test tests_world[];
 extern const th_test tests_wcsph[];
 extern const th_test tests_compile[];
+extern const th_test tests_iisph[];
+extern const th_test tests_iisph_long[]; /* long runs: only with --long (make validate) */
 
 void th_fail(const char* file, int line, const char* fmt, ...);
 void th_note(const char* fmt, ...);

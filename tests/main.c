@@ -9,7 +9,8 @@
 #endif
 
 static const th_test* const th_tables[] = {tests_kernels, tests_grid, tests_world, tests_wcsph,
-                                           tests_compile};
+                                           tests_iisph, tests_compile};
+static const th_test* const th_long_tables[] = {tests_iisph_long};
 
 static int th_failed_checks;
 static int th_skip_flag;
@@ -52,37 +53,50 @@ static double th_now(void) {
 #endif
 }
 
-int main(int argc, char** argv) {
-    int passed = 0, failed = 0, skipped = 0;
-    size_t t;
-    for (t = 0; t < sizeof(th_tables) / sizeof(th_tables[0]); ++t) {
-        const th_test* test;
-        for (test = th_tables[t]; test->name; ++test) {
-            double t0;
-            int a, selected = argc < 2;
-            for (a = 1; a < argc; ++a)
-                if (strstr(test->name, argv[a])) selected = 1;
-            if (!selected) continue;
-            th_current = test->name;
-            th_failed_checks = 0;
-            th_skip_flag = 0;
-            fprintf(stdout, "%-48s\n", test->name);
-            fflush(stdout);
-            t0 = th_now();
-            test->fn();
-            if (th_failed_checks) {
-                ++failed;
-                fprintf(stdout, "  FAIL %s (%d failed checks, %.2f s)\n", test->name,
-                        th_failed_checks, th_now() - t0);
-            } else if (th_skip_flag) {
-                ++skipped;
-            } else {
-                ++passed;
-                fprintf(stdout, "  ok   %s (%.2f s)\n", test->name, th_now() - t0);
-            }
-            fflush(stdout);
+static void th_run_table(const th_test* table, int argc, char** argv, int* passed, int* failed,
+                         int* skipped) {
+    const th_test* test;
+    for (test = table; test->name; ++test) {
+        double t0;
+        int a, selected = 1, filters = 0;
+        for (a = 1; a < argc; ++a) {
+            if (strcmp(argv[a], "--long") == 0) continue;
+            if (!filters) selected = 0;
+            ++filters;
+            if (strstr(test->name, argv[a])) selected = 1;
         }
+        if (!selected) continue;
+        th_current = test->name;
+        th_failed_checks = 0;
+        th_skip_flag = 0;
+        fprintf(stdout, "%-48s\n", test->name);
+        fflush(stdout);
+        t0 = th_now();
+        test->fn();
+        if (th_failed_checks) {
+            ++*failed;
+            fprintf(stdout, "  FAIL %s (%d failed checks, %.2f s)\n", test->name, th_failed_checks,
+                    th_now() - t0);
+        } else if (th_skip_flag) {
+            ++*skipped;
+        } else {
+            ++*passed;
+            fprintf(stdout, "  ok   %s (%.2f s)\n", test->name, th_now() - t0);
+        }
+        fflush(stdout);
     }
+}
+
+int main(int argc, char** argv) {
+    int passed = 0, failed = 0, skipped = 0, a, with_long = 0;
+    size_t t;
+    for (a = 1; a < argc; ++a)
+        if (strcmp(argv[a], "--long") == 0) with_long = 1;
+    for (t = 0; t < sizeof(th_tables) / sizeof(th_tables[0]); ++t)
+        th_run_table(th_tables[t], argc, argv, &passed, &failed, &skipped);
+    if (with_long)
+        for (t = 0; t < sizeof(th_long_tables) / sizeof(th_long_tables[0]); ++t)
+            th_run_table(th_long_tables[t], argc, argv, &passed, &failed, &skipped);
     (void)th_current;
     if (skipped) fprintf(stdout, "%d skipped\n", skipped);
     fprintf(stdout, "%d passed, %d failed\n", passed, failed);

@@ -124,8 +124,10 @@ static void test_hydrostatic(void) {
     }
 }
 
-/* Summation density (negative pressure clamped at the free surface) also holds a tank at rest;
-   the surface's density deficit makes it noisier. */
+/* Summation density (negative pressure clamped at the free surface) also holds a tank at rest.
+   Its density deficit within a kernel support of the surface leaves a layer of about 1.5-2 dx
+   at zero pressure, which lowers the interior profile by rho g (1.5-2 dx): 7.5-10 % of rho g H
+   at 20 particles deep, about half of that on average over the interior (hence 6 %). */
 static void test_hydrostatic_summation(void) {
     sph_world_def def = sph_world_def_default(2);
     hs_result r;
@@ -133,7 +135,7 @@ static void test_hydrostatic_summation(void) {
     r = run_hydrostatic(def, SPH_EOS_TAIT, 20, 1.5, 0.5);
     TH_NOTE("summation density: pressure error mean %.4f max %.4f, slope %.4f, outside %zu",
             r.err_mean, r.err_max, r.slope, r.outside);
-    CHECK_LT(r.err_mean, 0.04);
+    CHECK_LT(r.err_mean, 0.06);
     CHECK_EQ_INT(r.outside, 0);
 }
 
@@ -145,6 +147,29 @@ static void test_hydrostatic_linear_eos(void) {
     CHECK_LT(r.err_mean, 0.015);
     CHECK_NEAR(r.slope, 1, 0.035);
     CHECK_EQ_INT(r.outside, 0);
+}
+
+/* The boundary pressure schemes of the iterative solvers are available to WCSPH too, with the
+   same walls, but only extrapolation fits a pressure that follows the density. Mirroring sets
+   dp/dn = 0 at the wall where hydrostatics needs rho g . n: the tank holds, but the pressure
+   slope comes out about 20 % steep at 20 particles deep. Zero pressure cannot balance the push of
+   the fluid above the wall-adjacent layer until the layer is compressed, and particles get through
+   the floor: the test asserts that the library counts them (w.stats.n_outside), never losing them
+   silently. */
+static void test_hydrostatic_boundary_schemes(void) {
+    sph_world_def def = sph_world_def_default(2);
+    hs_result r;
+    def.boundary_pressure = SPH_BP_MIRROR;
+    r = run_hydrostatic(def, SPH_EOS_TAIT, 20, 1.5, 0.5);
+    TH_NOTE("WCSPH, mirrored walls: pressure error mean %.4f max %.4f of rho g H, slope %.4f, "
+            "outside %zu", r.err_mean, r.err_max, r.slope, r.outside);
+    CHECK_EQ_INT(r.outside, 0);
+    CHECK_LT(0.1, r.slope - 1); /* the known Neumann error, so that a change in it is noticed */
+    def.boundary_pressure = SPH_BP_ZERO;
+    r = run_hydrostatic(def, SPH_EOS_TAIT, 20, 1.5, 0.5);
+    TH_NOTE("WCSPH, zero-pressure walls: %zu particles counted below the floor (kept, reported)",
+            r.outside);
+    CHECK_LT(0, r.outside);
 }
 
 /* Water columns in 1D (gravity along x) and 3D (a 0.2 m wide tank, not a whole number of
@@ -654,27 +679,38 @@ static void add_gravity(const sph_world* w, size_t begin, size_t end, sph_real* 
     for (i = begin; i < end; ++i) acc[i * (size_t)w->dim + 1] += (sph_real)-9.81;
 }
 
+/* Runs two dam breaks built from d1 and d2 side by side for `steps` steps and reports whether
+   positions, velocities and densities stay bitwise identical. b_no_gravity: world b gets its
+   gravity only for the hydrostatic start (it must come from its force callback afterwards). */
+static int twins_identical(sph_world_def d1, sph_world_def d2, int steps, int b_no_gravity,
+                           double* v_max) {
+    sph_world a, b;
+    int s, same;
+    CHECK_EQ_INT(scene_dam_break(&a, d1, 0.1, 10, NULL), SPH_OK);
+    CHECK_EQ_INT(scene_dam_break(&b, d2, 0.1, 10, NULL), SPH_OK);
+    if (a.n == 0 || b.n == 0) return 0;
+    if (b_no_gravity) b.def.gravity[1] = 0;
+    for (s = 0; s < steps; ++s) {
+        CHECK_EQ_INT(sph_step(&a, 2e-4), SPH_OK);
+        CHECK_EQ_INT(sph_step(&b, 2e-4), SPH_OK);
+    }
+    same = memcmp(a.x, b.x, a.n * 2 * sizeof(sph_real)) == 0 &&
+           memcmp(a.v, b.v, a.n * 2 * sizeof(sph_real)) == 0 &&
+           memcmp(a.rho, b.rho, a.n * sizeof(sph_real)) == 0;
+    *v_max = a.stats.v_max;
+    sph_world_free(&a);
+    sph_world_free(&b);
+    return same;
+}
+
 /* A uniform user acceleration has exactly gravity's effect: a dam break with gravity off and the
    callback adding -9.81 m/s^2 is bitwise identical to one with gravity on. */
 static void test_force_callback_is_gravity(void) {
     sph_world_def d1 = sph_world_def_default(2), d2 = sph_world_def_default(2);
-    sph_world a, b;
-    int s;
+    double vmax = 0;
     d2.force = add_gravity;
-    CHECK_EQ_INT(scene_dam_break(&a, d1, 0.1, 10, NULL), SPH_OK);
-    CHECK_EQ_INT(scene_dam_break(&b, d2, 0.1, 10, NULL), SPH_OK);
-    if (a.n == 0 || b.n == 0) return;
-    b.def.gravity[1] = 0; /* gravity only for the hydrostatic start; from now on the callback */
-    for (s = 0; s < 200; ++s) {
-        CHECK_EQ_INT(sph_step(&a, 2e-4), SPH_OK);
-        CHECK_EQ_INT(sph_step(&b, 2e-4), SPH_OK);
-    }
-    CHECK(memcmp(a.x, b.x, a.n * 2 * sizeof(sph_real)) == 0);
-    CHECK(memcmp(a.v, b.v, a.n * 2 * sizeof(sph_real)) == 0);
-    CHECK(memcmp(a.rho, b.rho, a.n * sizeof(sph_real)) == 0);
-    CHECK_LT(0.2, a.stats.v_max); /* it moved: about g t = 0.4 m/s */
-    sph_world_free(&a);
-    sph_world_free(&b);
+    CHECK(twins_identical(d1, d2, 200, 1, &vmax));
+    CHECK_LT(0.2, vmax); /* it moved: about g t = 0.4 m/s */
 }
 
 /* ---- time integration ---------------------------------------------------------------------- */
@@ -791,19 +827,9 @@ static void test_advance_substeps(void) {
    equation when all masses are equal: the runs are bitwise identical. */
 static void test_particle_density_equals_continuity(void) {
     sph_world_def d1 = sph_world_def_default(2), d2 = sph_world_def_default(2);
-    sph_world a, b;
-    int s;
+    double vmax = 0;
     d2.density = SPH_DENSITY_PARTICLE;
-    CHECK_EQ_INT(scene_dam_break(&a, d1, 0.1, 10, NULL), SPH_OK);
-    CHECK_EQ_INT(scene_dam_break(&b, d2, 0.1, 10, NULL), SPH_OK);
-    for (s = 0; s < 100; ++s) {
-        CHECK_EQ_INT(sph_step(&a, 2e-4), SPH_OK);
-        CHECK_EQ_INT(sph_step(&b, 2e-4), SPH_OK);
-    }
-    CHECK(memcmp(a.rho, b.rho, a.n * sizeof(sph_real)) == 0);
-    CHECK(memcmp(a.x, b.x, a.n * 2 * sizeof(sph_real)) == 0);
-    sph_world_free(&a);
-    sph_world_free(&b);
+    CHECK(twins_identical(d1, d2, 100, 0, &vmax));
 }
 
 /* ---- determinism --------------------------------------------------------------------------- */
@@ -848,6 +874,7 @@ const th_test tests_wcsph[] = {
     {"wcsph/hydrostatic_tank", test_hydrostatic},
     {"wcsph/hydrostatic_tank_summation", test_hydrostatic_summation},
     {"wcsph/hydrostatic_tank_linear_eos", test_hydrostatic_linear_eos},
+    {"wcsph/hydrostatic_tank_boundary_schemes", test_hydrostatic_boundary_schemes},
     {"wcsph/hydrostatic_1d_3d", test_hydrostatic_1d_3d},
     {"wcsph/dam_break_martin_moyce", test_dam_break},
     {"wcsph/moving_piston", test_moving_piston},
