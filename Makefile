@@ -16,7 +16,8 @@ CFLAGS  ?= $(OPT) -std=c99 $(WARN)
 B        = build
 
 TEST_SRC = tests/main.c tests/impl.c tests/test_kernels.c tests/test_grid.c \
-           tests/test_world.c tests/test_wcsph.c tests/test_iisph.c tests/test_compile.c \
+           tests/test_world.c tests/test_wcsph.c tests/test_pcisph.c tests/test_iisph.c \
+           tests/test_compile.c \
            tests/compile_second.c \
            tests/compile_static.c
 TEST_CXX = tests/compile_cpp.cpp

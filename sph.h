@@ -1,8 +1,10 @@
 /* sph.h - smoothed particle hydrodynamics in one header. MIT licence (see end of file).
 
    A plain-struct particle world, SPH kernels, a cell grid for neighbour search, and time steps
-   for weakly compressible SPH (WCSPH) and implicit incompressible SPH (IISPH) with particle
-   walls (three boundary pressure schemes), moving and irregular boundaries, and user forces.
+   for weakly compressible SPH (WCSPH), predictive-corrective incompressible SPH (PCISPH, the
+   original and an enhanced multiphase version) and implicit incompressible SPH (IISPH), with
+   particle walls (three boundary pressure schemes), moving and irregular boundaries, and user
+   forces.
    C99, also C++; libc and libm only; OpenMP when the compiler enables it.
 
    DO THIS in exactly one C or C++ file:
@@ -21,6 +23,7 @@
        >>boundaries    wall particles: Adami pressure extrapolation, no-slip
        >>stages        the shared stages; sph_stable_dt, sph_step, sph_advance
        >>wcsph         sph_step_wcsph
+       >>pcisph        sph_step_pcisph, sph_world_def_pcisph
        >>iisph         sph_step_iisph
        >>io            sph_write_csv, sph_write_vtk
 
@@ -114,6 +117,23 @@ int main(void) {
    (0.25 h / (c0 + |v|)), the viscous limit (0.125 h^2 / nu) and the force limit
    (0.25 sqrt(h / |a|)); sph_advance(&w, duration) steps with it, landing exactly on the end.
 
+   SOLVER: PCISPH (sph_step_pcisph; sph_world_def_pcisph(&def, enhanced) sets it up)
+   Predict-correct loop (Solenthaler & Pajarola 2009, seed 000): pressures are corrected from
+   the predicted density error until its mean is below def.tolerance (the presets use 0.01 % and
+   at least 3 iterations); the last correction moves the particles. enhanced = 0 is the original
+   (summation density on predicted positions, one gain per phase from a full lattice neighbour-
+   hood). enhanced = 1 is seed 000's engineering version: continuity density with delta-SPH,
+   pressure smoothing (chi = 0.8), extrapolated walls with a Shepard wall density, Stormer-Verlet,
+   a gain per particle from its actual neighbours and the multiphase pressure gradient, warm
+   started from half the last pressure. Each part stays switchable through its def field. With
+   density ratios of 0.2 and below, or interfaces that mix (Rayleigh-Taylor), choose
+   def.density = SPH_DENSITY_PARTICLE (Ott & Schnetter): seed 000's continuity equation lets a
+   light particle at an interface take its heavy neighbours' masses (the tests show the 0.2 tank
+   failing with it and holding with particle density). The original PCISPH cannot hold two phases
+   of different density at all (summation smears the mass jump): it fails within a few steps and
+   says so. Large first steps from rest need def.max_dt (the original restarts every step from
+   zero pressure). delta-SPH uses c = cfl h / dt, the speed for which dt is the acoustic step.
+
    SOLVER: IISPH (sph_step_iisph, or def.solver = SPH_SOLVER_IISPH)
    Implicit incompressible SPH (Ihmsen et al. 2014, seed 003): summation density, then a pressure
    that makes the predicted density the rest density, by relaxed Jacobi (def.omega = 0.5) from a
@@ -180,8 +200,8 @@ int main(void) {
    wall-clock time per stage; w.step_time_total and w.stage_time_total accumulate them.
 
    WHAT IT DOES NOT DO (yet)
-   The WCSPH and IISPH solvers are in this version; PCISPH and the explicit compressible
-   multiphase step are planned. No surface tension, no turbulence model, no rigid-body coupling
+   The WCSPH, PCISPH and IISPH solvers are in this version; the explicit compressible multiphase
+   step (energy equation, gas equations of state) is planned. No surface tension, no turbulence model, no rigid-body coupling
    (boundaries move kinematically), no adaptive resolution, no GPU.
 */
 /* ============================================================================================== */
@@ -357,8 +377,18 @@ SPHDEF void sph_neighbors_free(sph_neighbors* nl);
 
 typedef enum sph_solver {
     SPH_SOLVER_WCSPH = 0, /* weakly compressible SPH with an equation of state                */
-    SPH_SOLVER_IISPH      /* implicit incompressible SPH (Ihmsen et al. 2014), relaxed Jacobi  */
+    SPH_SOLVER_IISPH,     /* implicit incompressible SPH (Ihmsen et al. 2014), relaxed Jacobi  */
+    SPH_SOLVER_PCISPH     /* predictive-corrective incompressible SPH (Solenthaler & Pajarola
+                             2009) and the enhanced multiphase version of seed 000          */
 } sph_solver;
+
+/* PCISPH's pressure gain (seed 000 sec. 3.1, digest sec. 5.2). */
+typedef enum sph_pcisph_factor {
+    SPH_PCISPH_PROTOTYPE = 0, /* one factor per phase from a particle with a full lattice
+                                 neighbourhood (Solenthaler & Pajarola 2009, eq. 3.5) (default) */
+    SPH_PCISPH_PER_PARTICLE   /* per particle and step from its actual neighbours and masses
+                                 (seed 000 sec. 3.2.4): for multiphase flows                 */
+} sph_pcisph_factor;
 
 typedef enum sph_density {
     SPH_DENSITY_CONTINUITY = 0, /* d rho_i/dt = sum_j m_j v_ij . grad W_ij   (default)            */
@@ -477,12 +507,21 @@ typedef struct sph_world_def {
     sph_real cfl_viscous;      /* viscous limit dt <= cfl_viscous h^2 / nu; default 0.125         */
     sph_real cfl_force;        /* force limit dt <= cfl_force sqrt(h / |a|); default 0.25         */
     sph_real cfl_velocity;     /* incompressible solvers: dt <= cfl_velocity dx / |v|max; 0.4     */
+    sph_real max_dt;           /* upper bound for sph_stable_dt [s]; 0 (default) = none           */
     /* iterative pressure solvers (IISPH) */
     sph_real tolerance;        /* stop when the mean predicted compression <= tolerance; 0.001     */
     int min_iterations;        /* default 2                                                       */
     int max_iterations;        /* default 100                                                     */
     sph_real omega;            /* relaxed Jacobi weight; default 0.5                              */
-    sph_real warm_start;       /* initial pressure = warm_start * last step's pressure; 0.5       */
+    sph_real warm_start;       /* iterative solvers: initial pressure = warm_start * last pressure;
+                                  0.5 (sph_world_def_pcisph: 0 for the original, 0.5 enhanced)  */
+    sph_real tolerance_max;    /* PCISPH: also stop only when the largest compression <= this;
+                                  0 (default) = no such condition                              */
+    sph_pcisph_factor pcisph_factor; /* default SPH_PCISPH_PROTOTYPE                             */
+    sph_real pcisph_gain;      /* 1 (default): displacement dt^2 F/m of the original paper; 2: the
+                                  thesis' dt^2/2 F/m, which doubles the correction            */
+    sph_real pressure_smoothing; /* PCISPH: chi of p <- chi p + (1 - chi) <p> (seed 000 sec.
+                                  3.2.1); 1 (default) = off, [0, 1]                          */
     sph_real domain_lo[3];     /* [m] domain box; particles outside are counted in                */
     sph_real domain_hi[3];     /*     w.stats.n_outside. lo == hi in a direction: unbounded there  */
     int periodic[3];           /* nonzero: direction wraps over [domain_lo, domain_hi)            */
@@ -540,6 +579,8 @@ typedef struct sph__private {
     size_t ff_fw_cap, fb_fw_cap;
     sph_real* pr2;                  /* iterative solvers: p_i / rho_i^2 (scratch)                   */
     size_t pr2_cap;
+    sph_real *xp, *vp;              /* PCISPH: predicted positions and velocities (scratch)         */
+    size_t xp_cap, vp_cap;
     sph_real* b_sw;                 /* per wall particle: sum_f W_bf of its fluid neighbours        */
     int b_dirty;                    /* boundary particles changed since the last boundary grid     */
     int have_mass;                  /* w->mass is set                                               */
@@ -620,7 +661,9 @@ SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_r
 SPHDEF sph_status sph_add_boundary(sph_world* w, size_t n, const sph_real* x, const sph_real* vol,
                                    int body);
 /* Sets density and pressure of all fluid particles to hydrostatic equilibrium under gravity, with
-   zero pressure at the top of each column of fluid (columns of width dx across gravity). */
+   zero pressure at the top of each column of fluid (columns of width dx across gravity); the
+   density is the equation of state's for WCSPH and the rest density for the incompressible
+   solvers. */
 SPHDEF sph_status sph_set_hydrostatic(sph_world* w);
 /* The message of the last error (empty if none). */
 SPHDEF const char* sph_world_error(const sph_world* w);
@@ -649,6 +692,21 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration);
 
 /* One weakly compressible step of dt [s]. On SPH_ERR_ARG the world is unchanged. */
 SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt);
+
+/* ============================================================================================== */
+/* >>pcisph                                                                                       */
+/* ============================================================================================== */
+
+/* Settings for PCISPH in def: enhanced = 0 gives the original solver of Solenthaler & Pajarola
+   2009 (summation density on predicted positions, prototype factor, no diffusion or smoothing,
+   walls without extrapolated pressure, symplectic Euler); enhanced = 1 the engineering version of
+   seed 000 sec. 3.2 (continuity density with delta-SPH, pressure smoothing chi = 0.8, Adami walls
+   with the Shepard wall density, Stormer-Verlet, per-particle factor and the multiphase pressure
+   gradient). Each switch remains a def field to change afterwards. */
+SPHDEF void sph_world_def_pcisph(sph_world_def* def, int enhanced);
+/* One predictive-corrective step of dt [s]: pressures are corrected until the predicted density
+   error is below def.tolerance on average (and def.tolerance_max at most, if set). */
+SPHDEF sph_status sph_step_pcisph(sph_world* w, sph_real dt);
 
 /* ============================================================================================== */
 /* >>iisph                                                                                        */
@@ -1444,7 +1502,40 @@ SPHDEF sph_world_def sph_world_def_default(int dim) {
     d.max_iterations = 100;
     d.omega = SPH__R(0.5);        /* Ihmsen et al. 2014; seed 003 */
     d.warm_start = SPH__R(0.5);   /* Ihmsen et al. 2014 */
+    d.tolerance_max = 0;
+    d.pcisph_factor = SPH_PCISPH_PROTOTYPE;
+    d.pcisph_gain = 1;            /* Solenthaler & Pajarola 2009 */
+    d.pressure_smoothing = 1;
     return d;
+}
+
+SPHDEF void sph_world_def_pcisph(sph_world_def* def, int enhanced) {
+    if (!def) return;
+    def->solver = SPH_SOLVER_PCISPH;
+    /* Solenthaler & Pajarola iterate at least 3 times; 0.01 % mean density error is the
+       SPlisHSPlasH default (digest sec. 5.2). A looser tolerance leaves the fluid resting on a
+       standing compression near the tolerance, which keeps it oscillating. */
+    def->min_iterations = 3;
+    def->tolerance = SPH__R(1e-4);
+    if (enhanced) { /* seed 000 sec. 3.2 (a)-(e) */
+        def->density = SPH_DENSITY_CONTINUITY;
+        def->delta = SPH__R(0.1);
+        def->pressure_smoothing = SPH__R(0.8);
+        def->boundary_pressure = SPH_BP_EXTRAPOLATE;
+        def->integrator = SPH_INTEGRATOR_VERLET;
+        def->pcisph_factor = SPH_PCISPH_PER_PARTICLE;
+        def->pressure_grad = SPH_PGRAD_MULTIPHASE;
+        def->warm_start = SPH__R(0.5);
+    } else { /* Solenthaler & Pajarola 2009 (seed 000 Alg. 5) */
+        def->warm_start = 0;
+        def->density = SPH_DENSITY_SUMMATION;
+        def->delta = 0;
+        def->pressure_smoothing = 1;
+        def->boundary_pressure = SPH_BP_ZERO;
+        def->integrator = SPH_INTEGRATOR_SYMPLECTIC_EULER;
+        def->pcisph_factor = SPH_PCISPH_PROTOTYPE;
+        def->pressure_grad = SPH_PGRAD_SYMMETRIC;
+    }
 }
 
 /* Each check names the field and the value it rejects. */
@@ -1464,7 +1555,7 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
     for (k = 0; k < 3; ++k)
         SPH__CHECK(sph__finite((double)d->gravity[k]), "sph_world_def.gravity[%d] = %g: not finite",
                    k, (double)d->gravity[k]);
-    SPH__CHECK((int)d->solver >= 0 && d->solver <= SPH_SOLVER_IISPH,
+    SPH__CHECK((int)d->solver >= 0 && d->solver <= SPH_SOLVER_PCISPH,
                "sph_world_def.solver = %d: not a sph_solver", (int)d->solver);
     SPH__CHECK((int)d->boundary_pressure >= 0 && d->boundary_pressure <= SPH_BP_ZERO,
                "sph_world_def.boundary_pressure = %d: not a sph_boundary_pressure",
@@ -1477,6 +1568,8 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
                "sph_world_def.boundary_gamma = %g: must be in (0, 10]", (double)d->boundary_gamma);
     SPH__CHECK(sph__finite((double)d->cfl_velocity) && d->cfl_velocity > 0 && d->cfl_velocity <= 1,
                "sph_world_def.cfl_velocity = %g: must be in (0, 1]", (double)d->cfl_velocity);
+    SPH__CHECK(sph__finite((double)d->max_dt) && d->max_dt >= 0,
+               "sph_world_def.max_dt = %g: must be finite and >= 0 (0 = no bound)", (double)d->max_dt);
     SPH__CHECK(sph__finite((double)d->tolerance) && d->tolerance > 0 && d->tolerance < 1,
                "sph_world_def.tolerance = %g: must be in (0, 1)", (double)d->tolerance);
     SPH__CHECK(d->min_iterations >= 0 && d->min_iterations <= 100000,
@@ -1489,6 +1582,17 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
                "sph_world_def.omega = %g: must be in (0, 1]", (double)d->omega);
     SPH__CHECK(sph__finite((double)d->warm_start) && d->warm_start >= 0 && d->warm_start <= 1,
                "sph_world_def.warm_start = %g: must be in [0, 1]", (double)d->warm_start);
+    SPH__CHECK(sph__finite((double)d->tolerance_max) && d->tolerance_max >= 0 && d->tolerance_max < 1,
+               "sph_world_def.tolerance_max = %g: must be 0 (off) or in (0, 1)",
+               (double)d->tolerance_max);
+    SPH__CHECK((int)d->pcisph_factor >= 0 && d->pcisph_factor <= SPH_PCISPH_PER_PARTICLE,
+               "sph_world_def.pcisph_factor = %d: not a sph_pcisph_factor", (int)d->pcisph_factor);
+    SPH__CHECK(sph__finite((double)d->pcisph_gain) && d->pcisph_gain > 0 && d->pcisph_gain <= 4,
+               "sph_world_def.pcisph_gain = %g: must be in (0, 4]", (double)d->pcisph_gain);
+    SPH__CHECK(sph__finite((double)d->pressure_smoothing) && d->pressure_smoothing >= 0 &&
+                   d->pressure_smoothing <= 1,
+               "sph_world_def.pressure_smoothing = %g: must be in [0, 1]",
+               (double)d->pressure_smoothing);
     SPH__CHECK((int)d->density >= 0 && d->density <= SPH_DENSITY_PARTICLE,
                "sph_world_def.density = %d: not a sph_density", (int)d->density);
     SPH__CHECK((int)d->pressure_grad >= 0 && d->pressure_grad <= SPH_PGRAD_MULTIPHASE,
@@ -1583,13 +1687,24 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
     return SPH_OK;
 }
 
+typedef struct sph__array {
+    void** ptr;
+    size_t elem;
+    int persistent;
+} sph__array;
+
+static int sph__fluid_arrays(sph_world* w, sph__array* a);
+static int sph__boundary_arrays(sph_world* w, sph__array* a);
+
 SPHDEF void sph_world_free(sph_world* w) {
+    struct sph__array arr[16];
+    int k, n;
     if (!w) return;
-    SPH_FREE(w->x); SPH_FREE(w->v); SPH_FREE(w->rho); SPH_FREE(w->p); SPH_FREE(w->m);
-    SPH_FREE(w->id); SPH_FREE(w->phase); SPH_FREE(w->a); SPH_FREE(w->drho);
-    SPH_FREE(w->b_x); SPH_FREE(w->b_v); SPH_FREE(w->b_a); SPH_FREE(w->b_x0); SPH_FREE(w->b_vol);
-    SPH_FREE(w->b_p); SPH_FREE(w->b_rho); SPH_FREE(w->b_vw); SPH_FREE(w->b_id);
-    SPH_FREE(w->b_body);
+    /* the particle arrays through the same lists that grow and reorder them */
+    n = sph__fluid_arrays(w, arr);
+    for (k = 0; k < n; ++k) SPH_FREE(*arr[k].ptr);
+    n = sph__boundary_arrays(w, arr);
+    for (k = 0; k < n; ++k) SPH_FREE(*arr[k].ptr);
     sph_grid_free(&w->priv.grid);
     sph_grid_free(&w->priv.bgrid);
     sph_neighbors_free(&w->priv.ff);
@@ -1605,6 +1720,8 @@ SPHDEF void sph_world_free(sph_world* w) {
     SPH_FREE(w->priv.ff_fw);
     SPH_FREE(w->priv.fb_fw);
     SPH_FREE(w->priv.pr2);
+    SPH_FREE(w->priv.xp);
+    SPH_FREE(w->priv.vp);
     memset(w, 0, sizeof(*w));
     w->error_index = -1;
 }
@@ -1614,11 +1731,6 @@ SPHDEF const char* sph_world_error(const sph_world* w) { return w ? w->error : "
 /* The per-particle arrays, listed once so that growing and reordering cannot forget one.
    persistent arrays carry state from step to step and follow the particles when they are sorted;
    the others are recomputed inside every step. */
-typedef struct sph__array {
-    void** ptr;
-    size_t elem;
-    int persistent;
-} sph__array;
 
 static int sph__fluid_arrays(sph_world* w, sph__array* a) {
     const size_t vec = (size_t)w->dim * sizeof(sph_real), r = sizeof(sph_real);
@@ -2007,7 +2119,8 @@ SPHDEF size_t sph_world_memory(const sph_world* w) {
              sph__neighbors_memory(&w->priv.bf) + sph__neighbors_memory(&w->priv.bb);
     bytes += w->priv.perm_cap + w->priv.block_cap * sizeof(double) +
              (w->priv.rho_n_cap + w->priv.aii_cap + w->priv.src_cap + w->priv.ap_cap +
-              w->priv.ff_fw_cap + w->priv.fb_fw_cap + w->priv.pr2_cap) *
+              w->priv.ff_fw_cap + w->priv.fb_fw_cap + w->priv.pr2_cap + w->priv.xp_cap +
+              w->priv.vp_cap) *
                  sizeof(sph_real);
     return bytes;
 }
@@ -2085,6 +2198,7 @@ typedef struct sph__ctx {
     int density, pgrad, noslip, laminar, morris, av, delta_on;
     int bp_mode;               /* sph_boundary_pressure                                          */
     const sph_real *ff_fw, *fb_fw; /* cached grad W factors per listed pair (SPH__CACHED passes)  */
+    sph_real delta_c;          /* if > 0, the speed in the delta-SPH term instead of each phase's c0 */
     const sph_real* pr2;       /* p / rho^2 per fluid particle (SPH__CACHED passes)              */
     int eos_walls;             /* wall density from the equation of state (WCSPH) or a Shepard
                                   average of the fluid's (solvers without one, seed 000 sec. 3.2.3) */
@@ -2358,7 +2472,11 @@ SPHDEF sph_status sph_set_hydrostatic(sph_world* w) {
                 p += gmag * 0.5 * (rho0 + rho0p) * (it[i - 1].s - it[i].s);
             }
             w->p[j] = (sph_real)p;
-            w->rho[j] = c.pc[w->phase[j]].rho0 * sph__eos_inverse(&c.pc[w->phase[j]], (sph_real)p);
+            /* weakly compressible: the density the equation of state gives that pressure;
+               incompressible solvers: the rest density */
+            w->rho[j] = w->def.solver == SPH_SOLVER_WCSPH
+                            ? c.pc[w->phase[j]].rho0 * sph__eos_inverse(&c.pc[w->phase[j]], (sph_real)p)
+                            : c.pc[w->phase[j]].rho0;
         }
         a = b;
     }
@@ -2375,6 +2493,8 @@ static sph_status sph__scratch(sph_world* w, sph_real** p, size_t count) {
                   : p == &w->priv.ff_fw ? &w->priv.ff_fw_cap
                   : p == &w->priv.fb_fw ? &w->priv.fb_fw_cap
                   : p == &w->priv.pr2   ? &w->priv.pr2_cap
+                  : p == &w->priv.xp    ? &w->priv.xp_cap
+                  : p == &w->priv.vp    ? &w->priv.vp_cap
                                         : NULL;
     SPH_ASSERT(cap);
     if (count <= *cap && *p) return SPH_OK;
@@ -2593,7 +2713,7 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
     const sph_real rhoi = c->rho[i], pi = c->p[i], mi = c->m ? c->m[i] : c->m0;
     const sph_real inv_rhoi = 1 / rhoi, pi_r2 = pi * inv_rhoi * inv_rhoi;
     const sph_real rhati = rhoi * P->inv_rho0;
-    const sph_real dcoef = c->delta * c->h * P->c0 * 2 * P->rho0;
+    const sph_real dcoef = c->delta * c->h * (c->delta_c > 0 ? c->delta_c : P->c0) * 2 * P->rho0;
     const int os = c->density == SPH_DENSITY_PARTICLE;
     sph_real ai[3] = {0, 0, 0}, R = 0;
     size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
@@ -2715,6 +2835,7 @@ static void sph__stage_interact(sph_world* w, const sph__ctx* c, int flags, sph_
 #define SPH__CASES(D)                                                                              \
     case D * 32 + SPH__ACCEL: SPH__LOOP(D, SPH__ACCEL); break;                                     \
     case D * 32 + SPH__VISCOUS: SPH__LOOP(D, SPH__VISCOUS); break;                                 \
+    case D * 32 + (SPH__PRESSURE | SPH__SET): SPH__LOOP(D, SPH__PRESSURE | SPH__SET); break;       \
     case D * 32 + (SPH__PRESSURE | SPH__SET | SPH__CACHED):                                          \
         SPH__LOOP(D, SPH__PRESSURE | SPH__SET | SPH__CACHED); break;                               \
     case D * 32 + SPH__RATE: SPH__LOOP(D, SPH__RATE); break;
@@ -3103,6 +3224,296 @@ SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt) {
 }
 
 /* ============================================================================================== */
+/* >>pcisph (implementation)                                                                      */
+/* ============================================================================================== */
+/* Predictive-corrective incompressible SPH (Solenthaler & Pajarola 2009; seed 000 Alg. 5 and
+   sec. 3.2). Each step, after the non-pressure accelerations a_np:
+     p = warm_start * p^{n-1} (Alg. 5: 0), a_p = 0;  repeat:
+       v* = v^n + dt (a_np + a_p)
+       rho* = summation over predicted positions x* = x + dt v*           (original)
+            | rho^n + dt [sum_j m_j (v*_i - v*_j).grad W_ij + delta-SPH]   (enhanced, seed 000
+              sec. 3.2.1 and 3.2.4; Ott-Schnetter's m_i with SPH_DENSITY_PARTICLE)
+       p_i = max(0, p_i + f_i (rho*_i - rho0_i))      negative pressure is clamped (free surfaces)
+       [p_i = chi p_i + (1 - chi) <p>_i]              pressure smoothing, seed 000 sec. 3.2.1
+       a_p = pressure acceleration of p (at x* with summation density, at x^n otherwise)
+     until the mean compression max(rho* / rho0 - 1, 0) <= tolerance (and the largest <= tolerance_max
+     if set), after min_iterations and at most max_iterations; then v^{n+1} = v^n + dt (a_np + a_p)
+     with the last a_p, x^{n+1} = x^n + dt v^{n+1}, and with continuity rho^{n+1} = rho^n + dt R(v^{n+1}).
+   The gain f (seed 000 eq. 3.5 and sec. 3.2.4; the factor 2 of digest sec. 5.2 is pcisph_gain):
+     prototype    f = gain rho0^2 / (2 dt^2 m^2 sum_j |grad W_0j|^2), a full lattice neighbourhood
+                  (where sum_j grad W_0j = 0), per phase;
+     per particle f_i = gain rho_i / (2 dt^2 [(sum_j V_j gW_ij).(sum_j m_j gW_ij) + m_i sum_j V_j |gW_ij|^2])
+                  from the actual neighbours and masses at x^n (walls in the first product), per step.
+   With summation density the predicted density is divided by the lattice sum S, so f is too.
+   Decisions where seed 000 is silent (digest sec. 12):
+     (b) diffusion and smoothing act inside the loop: delta-SPH is part of every predicted
+         density (it must be, or the correction would undo it), and the accumulated pressure is
+         smoothed after each correction (Shepard-normalised, so free surfaces and walls are not
+         biased low), i.e. the iteration converges to a smooth pressure;
+     (c) wall pressure is extrapolated from the current pressure in every iteration, the wall
+         density is the Shepard average of the fluid's (seed 000 sec. 3.2.3);
+     (e) Alg. 5 starts every step from p = 0: one step of gravity barely compresses the predicted
+         state, so the loop stops with a fraction of the hydrostatic pressure and the fluid sags
+         until a standing compression near the tolerance carries it (an underdamped, WCSPH-like
+         equilibrium). The enhanced preset warm-starts from half the last pressure, as IISPH;
+     (d) with Stormer-Verlet the positions drift half a step, the correction runs at the half step
+         and constrains the density at the end of the step, predicted by the midpoint rule
+         rho* = rho^n + dt R(x^{n+1/2}, (v^n + v*)/2) (or summation at x^{n+1/2} + dt/2 v*), which
+         responds to a velocity change with half the weight of the Euler prediction, so the gain
+         is doubled; the velocity kick and the second drift use the final pressure. */
+
+/* sum_j |grad W(x_j)|^2 over a square lattice of spacing dx (the prototype's neighbourhood). */
+static double sph__lattice_grad2(const sph_kernel* k, sph_real dx) {
+    const int R = (int)(k->radius / dx) + 1, D = k->dim;
+    double sum = 0;
+    int i, j, l;
+    for (i = -R; i <= R; ++i)
+        for (j = (D > 1 ? -R : 0); j <= (D > 1 ? R : 0); ++j)
+            for (l = (D > 2 ? -R : 0); l <= (D > 2 ? R : 0); ++l) {
+                const double g = (double)sph_kernel_dwdr(k, dx * sph__sqrt((sph_real)(i * i + j * j + l * l)));
+                sum += g * g;
+            }
+    return sum;
+}
+
+/* Denominator of the per-particle gain at x^n (without dt^2), seed 000 sec. 3.2.4:
+       (sum_j V_j gW_ij) . (sum_j mu_j gW_ij) + m_i sum_j (mu_j / rho_j) |gW_ij|^2,
+   where mu_j is the mass that weighs neighbour j in the density change: m_j for the continuity
+   equation (seed 000's derivation), m_i for Ott-Schnetter's particle density, for which the
+   seed-000 gain would be several times too large for a heavy particle among light ones (the
+   corrector then oscillates across a 5:1 interface). */
+SPH__INLINE sph_real sph__pcisph_denominator(const sph__ctx* c, size_t i, const int D) {
+    const sph_real* xi = c->x + i * (size_t)D;
+    const sph__phase_c* P = &c->pc[c->ph[i]];
+    const sph_real mi = c->m ? c->m[i] : c->m0;
+    const int os = c->density == SPH_DENSITY_PARTICLE;
+    sph_real sv[3] = {0, 0, 0}, sm[3] = {0, 0, 0}, q = 0, dot = 0;
+    size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
+    int k;
+    for (kk = k0; kk < k1; ++kk) {
+        const size_t j = c->ff->idx[kk];
+        const sph_real mj = c->m ? c->m[j] : c->m0, Vj = mj / c->rho[j], mu = os ? mi : mj;
+        sph_real d[3] = {0, 0, 0}, r2 = 0, fw;
+        sph__delta_vec(c, xi, c->x + j * (size_t)D, d, D);
+        for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+        fw = c->k.norm_g * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h);
+        for (k = 0; k < D; ++k) { sv[k] += Vj * fw * d[k]; sm[k] += mu * fw * d[k]; }
+        q += mu / c->rho[j] * fw * fw * r2;
+    }
+    if (c->has_b) {
+        k0 = c->fb->begin[i];
+        k1 = k0 + c->fb->count[i];
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t b = c->fb->idx[kk];
+            const sph_real Vb = c->bvol[b];
+            sph_real d[3] = {0, 0, 0}, r2 = 0, fw;
+            sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
+            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+            fw = c->k.norm_g * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h);
+            for (k = 0; k < D; ++k) { sv[k] += Vb * fw * d[k]; sm[k] += P->rho0 * Vb * fw * d[k]; }
+        }
+    }
+    for (k = 0; k < D; ++k) dot += sv[k] * sm[k];
+    return dot + mi * q;
+}
+
+/* Shepard-normalised kernel average of the pressure, blended: p <- chi p + (1 - chi) <p>.
+   Gather into scratch, then copy (every particle reads the old pressures). */
+static void sph__stage_smooth_pressure(sph_world* w, const sph__ctx* c, sph_real chi) {
+    const int D = c->dim;
+    const sph_real w0 = sph__kw(c->k.form, 0);
+    sph__idx i;
+    SPH__OMP_FOR(w->n)
+    for (i = 0; i < (sph__idx)w->n; ++i) {
+        const sph_real* xi = c->x + (size_t)i * (size_t)D;
+        const sph_real Vi = (c->m ? c->m[i] : c->m0) / c->rho[i];
+        sph_real num = Vi * c->p[i] * w0, den = Vi * w0;
+        size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t j = c->ff->idx[kk];
+            const sph_real Vj = (c->m ? c->m[j] : c->m0) / c->rho[j];
+            sph_real d[3] = {0, 0, 0}, r2 = 0, W;
+            int k;
+            sph__delta_vec(c, xi, c->x + j * (size_t)D, d, D);
+            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+            W = sph__kw(c->k.form, sph__sqrt(r2) * c->k.inv_h);
+            num += Vj * c->p[j] * W;
+            den += Vj * W;
+        }
+        w->priv.pr2[i] = chi * c->p[i] + (1 - chi) * num / den;
+    }
+    memcpy(w->p, w->priv.pr2, w->n * sizeof(sph_real));
+}
+
+static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
+    const int D = w->dim, verlet = w->def.integrator == SPH_INTEGRATOR_VERLET;
+    const int summation = w->def.density == SPH_DENSITY_SUMMATION;
+    const int per_particle = w->def.pcisph_factor == SPH_PCISPH_PER_PARTICLE;
+    const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK, nD = w->n * (size_t)D;
+    const sph_real drift = verlet ? SPH__R(0.5) * dt : dt;
+    /* with Verlet the predicted density sees half of a velocity change (midpoint rule, or a half
+       drift for summation), so the gain doubles */
+    const double S = (summation ? (double)w->priv.lattice_sum : 1.0) * (verlet ? 2.0 : 1.0);
+    double t0 = sph__now(), tstart = t0, err = 0, errmax = 0, proto[SPH_MAX_PHASES];
+    sph__ctx c;
+    sph_status s;
+    sph__idx i;
+    int it = 0, q;
+    if ((s = sph__scratch(w, &w->priv.aii, w->capacity)) != SPH_OK ||
+        (s = sph__scratch(w, &w->priv.ap, w->capacity * (size_t)D)) != SPH_OK ||
+        (s = sph__scratch(w, &w->priv.xp, w->capacity * (size_t)D)) != SPH_OK ||
+        (s = sph__scratch(w, &w->priv.vp, w->capacity * (size_t)D)) != SPH_OK ||
+        (s = sph__scratch(w, &w->priv.pr2, w->capacity)) != SPH_OK ||
+        (s = sph__scratch(w, &w->priv.rho_n, w->capacity)) != SPH_OK)
+        return s;
+    if (2 * nblk > w->priv.block_cap) {
+        if (!sph__grow((void**)&w->priv.block, 2 * nblk + 64, sizeof(double)))
+            return sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory (reduction blocks)");
+        w->priv.block_cap = 2 * nblk + 64;
+    }
+    if (verlet) { /* first drift; the correction then runs at the half step */
+        sph__ctx_init(w, &c);
+        s = sph__integrate(w, &c, 0, 0, SPH__R(0.5) * dt, 0);
+        if (s != SPH_OK) return s;
+    }
+    s = sph__boundary_motion(w, w->time + (verlet ? 0.5 * (double)dt : 0.0));
+    if (s != SPH_OK) return s;
+    sph__time(w, SPH_STAGE_BOUNDARY, &t0);
+    s = sph__stage_neighbors(w);
+    if (s != SPH_OK) return s;
+    sph__ctx_init(w, &c);
+    /* delta-SPH needs a speed of sound, which PCISPH does not have (seed 000 sec. 3.2.1 leaves it
+       open). The phase's c0 would make the explicit diffusion unstable at PCISPH's large steps
+       (delta h c0 dt / h^2 grows with dt); c = cfl h / dt is the speed for which dt is the
+       acoustic CFL step, so the term has per step the strength it has in WCSPH. */
+    c.delta_c = w->def.cfl * w->h / dt;
+    sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
+    if (summation) sph__stage_density_summation(w, &c);
+    memcpy(w->priv.rho_n, w->rho, w->n * sizeof(sph_real));
+    sph__time(w, SPH_STAGE_DENSITY, &t0);
+    /* non-pressure accelerations a_np (kept in w->a) */
+    sph__stage_body_force(w, &c);
+    if (w->nb > 0) sph__stage_wall(w, &c, SPH__WALL_STATE);
+    if (c.laminar || c.av) sph__stage_interact(w, &c, SPH__VISCOUS, w->a);
+    sph__time(w, SPH_STAGE_FORCES, &t0);
+    /* gains */
+    {
+        const double g2 = sph__lattice_grad2(&w->kernel, w->dx);
+        for (q = 0; q < w->nphase; ++q) {
+            const double m = (double)w->phases[q].mass, r0 = (double)w->phases[q].rest_density;
+            proto[q] = (double)w->def.pcisph_gain * S * r0 * r0 / (2 * (double)dt * (double)dt * m * m * g2);
+        }
+    }
+    SPH__OMP_FOR(w->n)
+    for (i = 0; i < (sph__idx)w->n; ++i) {
+        sph_real f;
+        if (per_particle) {
+            const sph_real den = D == 2   ? sph__pcisph_denominator(&c, (size_t)i, 2)
+                                 : D == 3 ? sph__pcisph_denominator(&c, (size_t)i, 3)
+                                          : sph__pcisph_denominator(&c, (size_t)i, 1);
+            f = den > 0 ? (sph_real)((double)w->def.pcisph_gain * S * (double)w->rho[i] /
+                                     (2 * (double)dt * (double)dt * (double)den))
+                        : 0;
+        } else {
+            f = (sph_real)proto[w->phase[i]];
+        }
+        w->priv.aii[i] = f;
+        w->p[i] = w->p[i] > 0 ? w->def.warm_start * w->p[i] : 0; /* Alg. 5: warm_start = 0 */
+    }
+    memset(w->priv.ap, 0, nD * sizeof(sph_real));
+    /* predict and correct */
+    for (;;) {
+        const size_t nb2 = nblk;
+        sph__idx blk;
+        /* predicted velocity (and, for the rate, the velocity it sees), positions */
+        SPH__OMP_FOR(nD)
+        for (i = 0; i < (sph__idx)nD; ++i) {
+            const sph_real vs = w->v[i] + dt * (w->a[i] + w->priv.ap[i]);
+            w->priv.xp[i] = w->x[i] + drift * vs;
+            w->priv.vp[i] = verlet ? SPH__R(0.5) * (w->v[i] + vs) : vs;
+        }
+        if (summation) {
+            sph__ctx cp = c;
+            cp.x = w->priv.xp;
+            sph__stage_density_summation(w, &cp);
+        } else {
+            sph__ctx cr = c;
+            cr.v = w->priv.vp;
+            sph__stage_interact(w, &cr, SPH__RATE, NULL);
+            SPH__OMP_FOR(w->n)
+            for (i = 0; i < (sph__idx)w->n; ++i) w->rho[i] = w->priv.rho_n[i] + dt * w->drho[i];
+        }
+        /* correct the pressure; mean and largest predicted compression (fixed-order blocks) */
+        SPH__OMP_FOR(w->n)
+        for (blk = 0; blk < (sph__idx)nb2; ++blk) {
+            const size_t i0 = (size_t)blk * SPH__BLOCK;
+            const size_t i1 = i0 + SPH__BLOCK < w->n ? i0 + SPH__BLOCK : w->n;
+            double e = 0, emax = 0;
+            size_t j;
+            for (j = i0; j < i1; ++j) {
+                const sph_real r0 = c.pc[w->phase[j]].rho0, drho = w->rho[j] - r0;
+                const sph_real p = w->p[j] + w->priv.aii[j] * drho;
+                const double comp = drho > 0 ? (double)(drho / r0) : 0.0;
+                w->p[j] = p > 0 ? p : 0;
+                e += comp;
+                if (comp > emax) emax = comp;
+            }
+            w->priv.block[2 * (size_t)blk] = e;
+            w->priv.block[2 * (size_t)blk + 1] = emax;
+        }
+        err = 0;
+        errmax = 0;
+        for (blk = 0; blk < (sph__idx)nb2; ++blk) {
+            err += w->priv.block[2 * (size_t)blk];
+            if (w->priv.block[2 * (size_t)blk + 1] > errmax) errmax = w->priv.block[2 * (size_t)blk + 1];
+        }
+        err = w->n ? err / (double)w->n : 0;
+        {
+            sph__ctx cq = c; /* pressure positions: predicted with summation density */
+            if (summation) cq.x = w->priv.xp;
+            if (w->def.pressure_smoothing < 1) sph__stage_smooth_pressure(w, &cq, w->def.pressure_smoothing);
+            if (w->nb > 0) sph__stage_wall(w, &cq, SPH__WALL_PRESSURE);
+            sph__stage_interact(w, &cq, SPH__PRESSURE | SPH__SET, w->priv.ap);
+        }
+        ++it;
+        if ((it >= w->def.min_iterations && err <= (double)w->def.tolerance &&
+             (w->def.tolerance_max <= 0 || errmax <= (double)w->def.tolerance_max)) ||
+            it >= w->def.max_iterations)
+            break;
+    }
+    sph__time(w, SPH_STAGE_PRESSURE, &t0);
+    /* the motion uses the last pressure; with continuity the density follows the new velocity */
+    SPH__OMP_FOR(nD)
+    for (i = 0; i < (sph__idx)nD; ++i) {
+        const sph_real vn = w->v[i], v1 = vn + dt * (w->a[i] + w->priv.ap[i]);
+        w->priv.vp[i] = verlet ? SPH__R(0.5) * (vn + v1) : v1;
+        w->v[i] = v1;
+        w->a[i] += w->priv.ap[i]; /* total acceleration, for the diagnostics */
+    }
+    if (!summation) {
+        sph__ctx cr = c;
+        cr.v = w->priv.vp;
+        sph__stage_interact(w, &cr, SPH__RATE, NULL);
+        SPH__OMP_FOR(w->n)
+        for (i = 0; i < (sph__idx)w->n; ++i) w->rho[i] = w->priv.rho_n[i] + dt * w->drho[i];
+    }
+    w->stats.iterations = it;
+    w->stats.solver_error = err;
+    ++w->steps;
+    w->time += (double)dt;
+    s = sph__integrate(w, &c, 0, 0, drift, 1);
+    sph__time(w, SPH_STAGE_INTEGRATE, &t0);
+    w->stats.step_time = sph__now() - tstart;
+    return s;
+}
+
+SPHDEF sph_status sph_step_pcisph(sph_world* w, sph_real dt) {
+    sph_status s = sph__step_begin(w, dt);
+    if (s != SPH_OK) return s;
+    return sph__step_end(w, sph__step_pcisph(w, dt));
+}
+
+/* ============================================================================================== */
 /* >>iisph (implementation)                                                                       */
 /* ============================================================================================== */
 /* Implicit incompressible SPH, Ihmsen et al. 2014 in the form of Koschier et al. 2020 and seed 003
@@ -3346,7 +3757,7 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
     size_t i, k;
     int q;
     if (!w) return 0;
-    if ((int)solver < 0 || solver > SPH_SOLVER_IISPH) {
+    if ((int)solver < 0 || solver > SPH_SOLVER_PCISPH) {
         sph__fail(w, SPH_ERR_ARG, -1, "sph_stable_dt: solver %d is not a sph_solver", (int)solver);
         return 0;
     }
@@ -3389,6 +3800,7 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
         dt = fmin(dt, (double)w->def.cfl_viscous * (w->def.viscosity_form == SPH_VISC_MONAGHAN ? 0.8 : 1.0) *
                           (double)w->h * (double)w->h / numax);
     if (amax > 0) dt = fmin(dt, (double)w->def.cfl_force * sqrt((double)w->h / amax));
+    if (w->def.max_dt > 0) dt = fmin(dt, (double)w->def.max_dt);
     if (dt >= 1e300) {
         sph__fail(w, SPH_ERR_ARG, -1, "sph_stable_dt: nothing limits the step (no motion, no force, "
                                       "no viscosity); choose dt yourself");
@@ -3402,6 +3814,7 @@ SPHDEF sph_status sph_step(sph_world* w, sph_real dt) {
     switch (w->def.solver) {
     case SPH_SOLVER_WCSPH: return sph_step_wcsph(w, dt);
     case SPH_SOLVER_IISPH: return sph_step_iisph(w, dt);
+    case SPH_SOLVER_PCISPH: return sph_step_pcisph(w, dt);
     default: return sph__fail(w, SPH_ERR_ARG, -1, "sph_step: unknown solver %d", (int)w->def.solver);
     }
 }

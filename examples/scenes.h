@@ -208,6 +208,51 @@ SCENE_FN double scene_stirrer_extent(const sph_world* w, const scene_stirrer* st
     return worst;
 }
 
+/* Rayleigh-Taylor instability (validation-data.md sec. 5; seed 000 sec. 5.4): a closed 1 x 2 box,
+   heavy fluid (1.8) above light (1.0), interface y = 1 - 0.15 sin(2 pi x), g = -1, kinematic
+   viscosity 1/420 for both (Re = 420), no-slip walls, `res` particles per unit length. Phase 0
+   is the light fluid, phase 1 the heavy one. */
+SCENE_FN sph_status scene_rayleigh_taylor(sph_world* w, sph_world_def def, int res) {
+    const double dx = 1.0 / res, pi = 3.14159265358979323846;
+    sph_phase light, heavy;
+    sph_real *pl = NULL, *ph = NULL, lo[2] = {0, 0}, hi[2] = {1, 2};
+    size_t nl = 0, nh = 0;
+    int i, j, a, b;
+    memset(&light, 0, sizeof(light));
+    memset(&heavy, 0, sizeof(heavy));
+    light.rest_density = 1;
+    heavy.rest_density = (sph_real)1.8;
+    light.viscosity = heavy.viscosity = (sph_real)(1.0 / 420);
+    def.spacing = (sph_real)dx;
+    def.gravity[0] = 0;
+    def.gravity[1] = -1;
+    def.wall = SPH_WALL_NO_SLIP;
+    SCENE__TRY(sph_world_init(w, &def));
+    a = sph_world_add_phase(w, &light);
+    b = sph_world_add_phase(w, &heavy);
+    if (a < 0 || b < 0) return scene__fail(w, w->status);
+    pl = (sph_real*)malloc((size_t)(2 * res * res) * 2 * sizeof(sph_real));
+    ph = (sph_real*)malloc((size_t)(2 * res * res) * 2 * sizeof(sph_real));
+    if (!pl || !ph) { free(pl); free(ph); return scene__fail(w, SPH_ERR_NOMEM); }
+    for (j = 0; j < 2 * res; ++j)
+        for (i = 0; i < res; ++i) {
+            const double x = (i + 0.5) * dx, y = (j + 0.5) * dx;
+            sph_real* q = y > 1 - 0.15 * sin(2 * pi * x) ? ph + 2 * nh++ : pl + 2 * nl++;
+            q[0] = (sph_real)x;
+            q[1] = (sph_real)y;
+        }
+    if (sph_add_fluid(w, a, nl, pl, NULL) != SPH_OK || sph_add_fluid(w, b, nh, ph, NULL) != SPH_OK) {
+        free(pl);
+        free(ph);
+        return scene__fail(w, w->status);
+    }
+    free(pl);
+    free(ph);
+    SCENE__TRY(sph_add_wall_box(w, lo, hi, 0, 0));
+    SCENE__TRY(sph_set_hydrostatic(w));
+    return SPH_OK;
+}
+
 /* Surge front: the largest x of fluid particles within 0.1 a of the floor, plus half a spacing
    (a particle stands for a cell), in units of a (Martin & Moyce's Z). */
 SCENE_FN double scene_dam_front(const sph_world* w, const scene_dam* d) {
