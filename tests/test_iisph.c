@@ -83,7 +83,7 @@ static tank_result run_tank(sph_world_def def, double H, int layers, int closed,
         if (y < m) { r.near_floor += e; ++nf; continue; }
         r.particle_err += fabs(e);
         ++np;
-        b = (int)(y / (2 * dx)); /* layers two spacings thick */
+        b = (int)((y - m) / (2 * dx)); /* whole layers two spacings thick, from the exclusion edge */
         if (b < 128) { bins[b] += e; bc[b]++; }
     }
     for (b = 0; b < 128; ++b)

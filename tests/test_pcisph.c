@@ -60,7 +60,7 @@ static pc_tank run_pc_tank(int enhanced) {
         e = (ps[w.id[i]] / cn[w.id[i]] - 1000 * 9.81 * (H - y)) / (1000 * 9.81 * H);
         r.particle_err += fabs(e);
         ++np;
-        b = (int)(y / (2 * (double)w.dx));
+        b = (int)((y - m) / (2 * (double)w.dx)); /* whole layers from the exclusion edge */
         if (b < 64) { bins[b] += e; bc[b]++; }
     }
     for (b = 0; b < 64; ++b)
@@ -155,7 +155,7 @@ static two_layer run_two_layer(int enhanced, sph_density density, double ratio, 
         if ((w.phase[i] == 0 && y > 0.5 + dx) || (w.phase[i] == 1 && y < 0.5 - dx)) ++r.mixed;
         if (x < m || x > 1 - m || y < m || y > H - m || !cn[w.id[i]]) continue;
         pex = y > 0.5 ? ratio * 1000 * g * (H - y) : ratio * 1000 * g * 0.5 + 1000 * g * (0.5 - y);
-        b = (int)(y / (2 * dx));
+        b = (int)((y - m) / (2 * dx)); /* whole layers from the exclusion edge */
         bins[b] += (ps[w.id[i]] / cn[w.id[i]] - pex) / (1000 * g * H);
         bc[b]++;
     }
