@@ -17,11 +17,12 @@ B        = build
 
 TEST_SRC = tests/main.c tests/impl.c tests/test_kernels.c tests/test_grid.c \
            tests/test_world.c tests/test_wcsph.c tests/test_pcisph.c tests/test_iisph.c \
+           tests/test_compressible.c \
            tests/test_compile.c \
            tests/compile_second.c \
            tests/compile_static.c
 TEST_CXX = tests/compile_cpp.cpp
-TEST_DEP = sph.h tests/harness.h examples/scenes.h $(TEST_SRC) $(TEST_CXX)
+TEST_DEP = sph.h tests/harness.h tests/riemann.h bench/svg.h examples/scenes.h $(TEST_SRC) $(TEST_CXX)
 EXAMPLES = hello dambreak
 
 .PHONY: test validate demo examples check check-warnings check-sanitize check-float check-noomp \

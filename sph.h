@@ -25,6 +25,7 @@
        >>wcsph         sph_step_wcsph
        >>pcisph        sph_step_pcisph, sph_world_def_pcisph
        >>iisph         sph_step_iisph
+       >>compressible  sph_step_compressible, sph_add_fluid_ex (gases, shocks, large density ratios)
        >>io            sph_write_csv, sph_write_vtk
 
    COMPILE-TIME OPTIONS (define before including the implementation)
@@ -199,10 +200,26 @@ int main(void) {
    acceleration, kinetic energy, fluid neighbour pairs, particles outside the domain and the
    wall-clock time per stage; w.step_time_total and w.stage_time_total accumulate them.
 
+   SOLVER: COMPRESSIBLE (sph_step_compressible, or def.solver = SPH_SOLVER_COMPRESSIBLE)
+   Explicit compressible multiphase SPH (Ott & Schnetter 2003, seed 004): density by continuity
+   (use def.density = SPH_DENSITY_PARTICLE, eq. 11, when phases of very different density meet),
+   momentum by def.pressure_grad (SPH_PGRAD_MULTIPHASE is eq. 12), internal energy w.e [J/kg] by
+   eq. 13 written so that total energy is conserved to round-off, Monaghan 1992 artificial
+   viscosity with each particle's own sound speed. Per phase equation of state: Tait or linear
+   (no energy), SPH_EOS_IDEAL_GAS p = (gamma - 1) rho e (c0 follows from back_pressure, the
+   pressure at rest density; 0 gives dust), SPH_EOS_STIFFENED_GAS p = (gamma - 1) rho e - gamma
+   p_inf with p_inf from sound_speed (liquids under shocks). Gas phases get w.e (set by
+   sph_add_fluid / sph_fill_box to the back pressure; the host may overwrite it) and only this
+   step accepts them. dt = cfl h / max(c_i + |v_i|). sph_add_fluid_ex takes per-particle masses
+   and densities: put equal spacing and unequal masses across a density jump. Validated against
+   seed 004's advection, sound-wave and air | Diesel shock-tube tests, Toro's Riemann solutions
+   and a 1000:1 interface at rest (tests/test_compressible.c). With multiphase walls each phase
+   sees a wall pressure extrapolated from its own particles only.
+
    WHAT IT DOES NOT DO (yet)
-   The WCSPH, PCISPH and IISPH solvers are in this version; the explicit compressible multiphase
-   step (energy equation, gas equations of state) is planned. No surface tension, no turbulence model, no rigid-body coupling
-   (boundaries move kinematically), no adaptive resolution, no GPU.
+   No surface tension, no turbulence model, no rigid-body coupling (boundaries move kinematically),
+   no adaptive resolution, no GPU. A 1000:1 interface touching a side wall does not stay at rest
+   (the contact line breaks up within 0.2 s); periodic side boundaries do.
 */
 /* ============================================================================================== */
 /* >>config                                                                                       */
@@ -378,8 +395,11 @@ SPHDEF void sph_neighbors_free(sph_neighbors* nl);
 typedef enum sph_solver {
     SPH_SOLVER_WCSPH = 0, /* weakly compressible SPH with an equation of state                */
     SPH_SOLVER_IISPH,     /* implicit incompressible SPH (Ihmsen et al. 2014), relaxed Jacobi  */
-    SPH_SOLVER_PCISPH     /* predictive-corrective incompressible SPH (Solenthaler & Pajarola
+    SPH_SOLVER_PCISPH,    /* predictive-corrective incompressible SPH (Solenthaler & Pajarola
                              2009) and the enhanced multiphase version of seed 000          */
+    SPH_SOLVER_COMPRESSIBLE /* explicit compressible multiphase SPH with an energy equation
+                             (Ott & Schnetter 2003, seed 004): gases, shocks, large density
+                             ratios                                                          */
 } sph_solver;
 
 /* PCISPH's pressure gain (seed 000 sec. 3.1, digest sec. 5.2). */
@@ -398,7 +418,13 @@ typedef enum sph_density {
 
 typedef enum sph_pressure_grad {
     SPH_PGRAD_SYMMETRIC = 0, /* sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W_ij  (default)        */
-    SPH_PGRAD_MULTIPHASE     /* sum_j m_j (p_i + p_j)/(rho_i rho_j) grad W_ij (large density ratios) */
+    SPH_PGRAD_MULTIPHASE,    /* sum_j m_j (p_i + p_j)/(rho_i rho_j) grad W_ij (large density ratios;
+                                Ott & Schnetter eq. 12)                                          */
+    SPH_PGRAD_INTERFACE      /* 1/m_i sum_j (V_i^2 + V_j^2) p_ij grad W_ij, V = m/rho, with the
+                                density-weighted p_ij = (rho_j p_i + rho_i p_j)/(rho_i + rho_j)
+                                (Hu & Adams 2006; Adami, Hu & Adams 2013 eq. 7-8): eq. 12 inside
+                                a phase; at an interface the light side sees its own pressure,
+                                which holds a 1000:1 interface under gravity                    */
 } sph_pressure_grad;
 
 typedef enum sph_integrator {
@@ -444,9 +470,18 @@ typedef enum sph_pressure_clamp {
     SPH_CLAMP_OFF       /* negative pressures act as tension                                     */
 } sph_pressure_clamp;
 
+/* Equation of state of a phase. p_b is the phase's back_pressure: its pressure at rest density.
+   The gas forms depend on the specific internal energy e [J/kg] and need the compressible step,
+   which evolves e; Tait and linear depend on the density only. */
 typedef enum sph_eos {
-    SPH_EOS_TAIT = 0, /* p = B((rho/rho0)^gamma - 1) + p_b, B = rho0 c0^2 / gamma (default)       */
-    SPH_EOS_LINEAR    /* p = c0^2 (rho - rho0) + p_b                                            */
+    SPH_EOS_TAIT = 0,     /* p = B((rho/rho0)^gamma - 1) + p_b, B = rho0 c0^2 / gamma (default)   */
+    SPH_EOS_LINEAR,       /* p = c0^2 (rho - rho0) + p_b                                        */
+    SPH_EOS_IDEAL_GAS,    /* p = (gamma - 1) rho e; c^2 = gamma p / rho; gamma 0 = 1.4; the phase
+                             starts at e0 with p(rho0, e0) = p_b                                 */
+    SPH_EOS_STIFFENED_GAS /* p = (gamma - 1) rho e - gamma p_inf, c^2 = gamma (p + p_inf) / rho
+                             (liquids in shocks; Harlow & Amsden 1971), with p_inf chosen so that
+                             c(rho0, p_b) = sound_speed: p_inf = rho0 c0^2 / gamma - p_b;
+                             gamma 0 = 4.4                                                      */
 } sph_eos;
 
 /* Faces of an axis-aligned box, for sph_add_wall_box's open_faces. */
@@ -526,7 +561,8 @@ typedef struct sph_world_def {
     sph_real domain_hi[3];     /*     w.stats.n_outside. lo == hi in a direction: unbounded there  */
     int periodic[3];           /* nonzero: direction wraps over [domain_lo, domain_hi)            */
     sph_real max_compression;  /* blow-up if rho/rho0 - 1 exceeds it; default 0.2; 0 = no check  */
-    sph_real max_speed;        /* blow-up if |v| exceeds it [m/s]; 0 (default) = the largest c0   */
+    sph_real max_speed;        /* blow-up if |v| exceeds it [m/s]; 0 (default) = the largest c0,
+                                  10 c0 in the compressible step                                 */
     sph_force_fn force;        /* optional external accelerations                                 */
     void* force_user;
     sph_boundary_fn boundary_motion; /* optional moving boundary particles                       */
@@ -538,11 +574,14 @@ typedef struct sph_world_def {
 typedef struct sph_phase {
     sph_real rest_density;   /* rho0 [kg/m^3]; required, > 0                                      */
     sph_real viscosity;      /* kinematic viscosity nu [m^2/s]; 0 = inviscid (default)            */
-    sph_real sound_speed;    /* c0 [m/s]; 0 = automatic: 10 * max(sqrt(2 |g| H), |v|max) at the
-                                first step, H = height of the phase's particles along gravity     */
+    sph_real sound_speed;    /* c0 [m/s] at rest density; 0 = automatic: 10 * max(sqrt(2 |g| H),
+                                |v|max) at the first step, H = height of the phase's particles
+                                along gravity. Required for a stiffened gas; an ideal gas's is
+                                sqrt(gamma p_b / rho0), filled in by sph_world_add_phase         */
     sph_eos eos;             /* default SPH_EOS_TAIT                                              */
-    sph_real gamma;          /* Tait exponent; 0 = 7                                              */
-    sph_real back_pressure;  /* p_b added by the equation of state [Pa]; default 0                */
+    sph_real gamma;          /* exponent; 0 = 7 (Tait), 1.4 (ideal gas), 4.4 (stiffened gas)      */
+    sph_real back_pressure;  /* p_b [Pa]: the pressure at rest density (the ambient pressure of a
+                                gas); default 0                                               */
     sph_real mass;           /* particle mass [kg]; 0 = rest_density * dx^dim                     */
 } sph_phase;
 
@@ -581,6 +620,13 @@ typedef struct sph__private {
     size_t pr2_cap;
     sph_real *xp, *vp;              /* PCISPH: predicted positions and velocities (scratch)         */
     size_t xp_cap, vp_cap;
+    sph_real *de, *cs, *vn;         /* compressible: energy rate, sound speed, v at the step start  */
+    size_t de_cap, cs_cap, vn_cap;
+    sph_real* bpq;                  /* multiphase walls: (p_b, rho_b/rho0) per wall particle and
+                                       phase, extrapolated from that phase's particles (scratch)   */
+    size_t bpq_cap;
+    int has_energy;                 /* w->e exists (a phase has a gas equation of state)            */
+    int solver;                     /* the sph_solver whose step is running                         */
     sph_real* b_sw;                 /* per wall particle: sum_f W_bf of its fluid neighbours        */
     int b_dirty;                    /* boundary particles changed since the last boundary grid     */
     int have_mass;                  /* w->mass is set                                               */
@@ -615,6 +661,8 @@ typedef struct sph_world {
     uint8_t* phase;            /* [n] phase index                                                  */
     sph_real* a;               /* [n*dim] acceleration of the last step [m/s^2] (scratch)          */
     sph_real* drho;            /* [n] density rate [kg/m^3/s] (scratch)                            */
+    sph_real* e;               /* [n] specific internal energy [J/kg]; NULL unless a phase has a
+                                  gas equation of state (then sph_step_compressible evolves it)  */
     uint32_t next_id;
 
     /* boundary particles, b = 0 .. nb-1 */
@@ -653,6 +701,13 @@ SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, cons
 /* Adds n fluid particles at x[i*dim + k] with velocities v (NULL = at rest), density rho0. */
 SPHDEF sph_status sph_add_fluid(sph_world* w, int phase, size_t n, const sph_real* x,
                                 const sph_real* v);
+/* The same with a mass m[i] [kg] and a density rho[i] [kg/m^3] per particle (either NULL: the
+   phase's mass, the rest density). Particles of a gas phase start at its back pressure (their
+   internal energy follows from the density); the Tait and linear laws give the pressure of the
+   density. New particles take indices old w.n .. w.n - 1 until the next step sorts them, so a
+   host may set w.e (or any state) of the particles it just added. */
+SPHDEF sph_status sph_add_fluid_ex(sph_world* w, int phase, size_t n, const sph_real* x,
+                                   const sph_real* v, const sph_real* m, const sph_real* rho);
 /* Adds wall particles around the box [lo, hi] (the fluid's container), `layers` deep (0 = enough
    layers to cover the kernel support). open_faces: SPH_FACE_* bits of faces left open. Body 0. */
 SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_real* hi,
@@ -718,10 +773,23 @@ SPHDEF sph_status sph_step_pcisph(sph_world* w, sph_real dt);
 SPHDEF sph_status sph_step_iisph(sph_world* w, sph_real dt);
 
 /* ============================================================================================== */
+/* >>compressible                                                                                 */
+/* ============================================================================================== */
+
+/* One explicit compressible step of dt [s] (Ott & Schnetter 2003, seed 004): density by the
+   def.density option (SPH_DENSITY_PARTICLE, eq. 11, for phases of very different density), the
+   momentum equation (eq. 12 with def.pressure_grad = SPH_PGRAD_MULTIPHASE), the internal energy
+   equation (eq. 13) and Monaghan's (1992) artificial viscosity with def.alpha, def.beta and each
+   particle's own sound speed; pressure from each phase's equation of state p(rho, e). Total
+   energy (kinetic + internal) is conserved to round-off without walls and body forces. On
+   SPH_ERR_ARG the world is unchanged. */
+SPHDEF sph_status sph_step_compressible(sph_world* w, sph_real dt);
+
+/* ============================================================================================== */
 /* >>io                                                                                           */
 /* ============================================================================================== */
 
-/* Fluid particles as CSV: id,phase,x,y[,z],vx,vy[,vz],rho,p. */
+/* Fluid particles as CSV: id,phase,x,y[,z],vx,vy[,vz],rho,p[,e] (e with gas phases). */
 SPHDEF sph_status sph_write_csv(const sph_world* w, const char* path);
 /* Fluid and boundary particles as a legacy ASCII VTK unstructured grid (opens in ParaView). */
 SPHDEF sph_status sph_write_vtk(const sph_world* w, const char* path);
@@ -1547,15 +1615,16 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
     SPH__CHECK(d->dim >= 1 && d->dim <= 3, "sph_world_def.dim = %d: must be 1, 2 or 3", d->dim);
     SPH__CHECK(sph__finite((double)d->spacing) && d->spacing > 0,
                "sph_world_def.spacing = %g: must be finite and > 0", (double)d->spacing);
-    SPH__CHECK(sph__finite((double)d->h_factor) && d->h_factor >= 0 && d->h_factor <= 10,
-               "sph_world_def.h_factor = %g: must be 0 (kernel default) or in (0, 10]",
+    /* up to 100: 1D studies use h = 20 dx (seed 004's sound wave) */
+    SPH__CHECK(sph__finite((double)d->h_factor) && d->h_factor >= 0 && d->h_factor <= 100,
+               "sph_world_def.h_factor = %g: must be 0 (kernel default) or in (0, 100]",
                (double)d->h_factor);
     SPH__CHECK((int)d->kernel >= 0 && d->kernel < SPH_KERNEL_COUNT,
                "sph_world_def.kernel = %d: not a sph_kernel_type", (int)d->kernel);
     for (k = 0; k < 3; ++k)
         SPH__CHECK(sph__finite((double)d->gravity[k]), "sph_world_def.gravity[%d] = %g: not finite",
                    k, (double)d->gravity[k]);
-    SPH__CHECK((int)d->solver >= 0 && d->solver <= SPH_SOLVER_PCISPH,
+    SPH__CHECK((int)d->solver >= 0 && d->solver <= SPH_SOLVER_COMPRESSIBLE,
                "sph_world_def.solver = %d: not a sph_solver", (int)d->solver);
     SPH__CHECK((int)d->boundary_pressure >= 0 && d->boundary_pressure <= SPH_BP_ZERO,
                "sph_world_def.boundary_pressure = %d: not a sph_boundary_pressure",
@@ -1595,7 +1664,7 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
                (double)d->pressure_smoothing);
     SPH__CHECK((int)d->density >= 0 && d->density <= SPH_DENSITY_PARTICLE,
                "sph_world_def.density = %d: not a sph_density", (int)d->density);
-    SPH__CHECK((int)d->pressure_grad >= 0 && d->pressure_grad <= SPH_PGRAD_MULTIPHASE,
+    SPH__CHECK((int)d->pressure_grad >= 0 && d->pressure_grad <= SPH_PGRAD_INTERFACE,
                "sph_world_def.pressure_grad = %d: not a sph_pressure_grad", (int)d->pressure_grad);
     SPH__CHECK((int)d->integrator >= 0 && d->integrator <= SPH_INTEGRATOR_VERLET,
                "sph_world_def.integrator = %d: not a sph_integrator", (int)d->integrator);
@@ -1664,6 +1733,7 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
     }
     w->dim = def->dim;
     w->dx = def->spacing;
+    w->priv.solver = (int)def->solver; /* until a step says which solver runs */
     hf = def->h_factor > 0 ? def->h_factor : sph_kernel_default_h_factor(def->kernel);
     w->def.h_factor = hf;
     w->h = hf * def->spacing;
@@ -1722,6 +1792,10 @@ SPHDEF void sph_world_free(sph_world* w) {
     SPH_FREE(w->priv.pr2);
     SPH_FREE(w->priv.xp);
     SPH_FREE(w->priv.vp);
+    SPH_FREE(w->priv.de);
+    SPH_FREE(w->priv.cs);
+    SPH_FREE(w->priv.vn);
+    SPH_FREE(w->priv.bpq);
     memset(w, 0, sizeof(*w));
     w->error_index = -1;
 }
@@ -1744,6 +1818,7 @@ static int sph__fluid_arrays(sph_world* w, sph__array* a) {
     a[n].ptr = (void**)&w->drho; a[n].elem = r; a[n++].persistent = 1; /* Verlet keeps it */
     a[n].ptr = (void**)&w->a; a[n].elem = vec; a[n++].persistent = 0;
     if (w->m) { a[n].ptr = (void**)&w->m; a[n].elem = r; a[n++].persistent = 1; }
+    if (w->priv.has_energy) { a[n].ptr = (void**)&w->e; a[n].elem = r; a[n++].persistent = 1; }
     return n;
 }
 
@@ -1800,9 +1875,16 @@ static int sph__check_phase(sph_world* w, int phase) {
     return 1;
 }
 
+/* p_inf of a stiffened gas (0 for the other equations of state) [Pa]. */
+static sph_real sph__pinf(const sph_phase* P) {
+    if (P->eos != SPH_EOS_STIFFENED_GAS) return 0;
+    return P->rest_density * P->sound_speed * P->sound_speed / P->gamma - P->back_pressure;
+}
+
 SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase) {
     sph_phase ph;
     double vol;
+    int gas;
     if (!w) return -1;
     if (!phase) { sph__fail(w, SPH_ERR_ARG, -1, "sph_world_add_phase: phase is NULL"); return -1; }
     if (w->nphase >= SPH_MAX_PHASES) {
@@ -1819,17 +1901,53 @@ SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase) {
     SPH__PCHECK(sph__finite((double)ph.sound_speed) && ph.sound_speed >= 0,
                 "sph_phase.sound_speed = %g: must be finite and >= 0 (0 = automatic)",
                 (double)ph.sound_speed);
-    SPH__PCHECK((int)ph.eos >= 0 && ph.eos <= SPH_EOS_LINEAR, "sph_phase.eos = %d: not a sph_eos",
-                (int)ph.eos);
+    SPH__PCHECK((int)ph.eos >= 0 && ph.eos <= SPH_EOS_STIFFENED_GAS,
+                "sph_phase.eos = %d: not a sph_eos", (int)ph.eos);
+    gas = ph.eos == SPH_EOS_IDEAL_GAS || ph.eos == SPH_EOS_STIFFENED_GAS;
     SPH__PCHECK(sph__finite((double)ph.gamma) && (ph.gamma == 0 || (ph.gamma >= 1 && ph.gamma <= 20)),
-                "sph_phase.gamma = %g: must be 0 (= 7) or in [1, 20]", (double)ph.gamma);
+                "sph_phase.gamma = %g: must be 0 (default) or in [1, 20]", (double)ph.gamma);
+    SPH__PCHECK(!gas || ph.gamma != 1,
+                "sph_phase.gamma = 1: a gas equation of state needs gamma > 1");
     SPH__PCHECK(sph__finite((double)ph.back_pressure), "sph_phase.back_pressure = %g: not finite",
                 (double)ph.back_pressure);
     SPH__PCHECK(sph__finite((double)ph.mass) && ph.mass >= 0,
                 "sph_phase.mass = %g: must be finite and >= 0 (0 = rest_density * dx^dim)",
                 (double)ph.mass);
+    if (ph.gamma == 0)
+        ph.gamma = ph.eos == SPH_EOS_IDEAL_GAS       ? SPH__R(1.4)
+                   : ph.eos == SPH_EOS_STIFFENED_GAS ? SPH__R(4.4)
+                                                     : 7;
+    if (ph.eos == SPH_EOS_IDEAL_GAS) {
+        const double c = sqrt((double)ph.gamma * (double)ph.back_pressure / (double)ph.rest_density);
+        SPH__PCHECK(ph.back_pressure >= 0,
+                    "sph_phase.back_pressure = %g: an ideal gas needs a pressure >= 0 (0: dust)",
+                    (double)ph.back_pressure);
+        SPH__PCHECK(ph.sound_speed == 0,
+                    "sph_phase.sound_speed = %g: an ideal gas's sound speed follows from gamma, "
+                    "back_pressure and rest_density (here %g m/s); leave it 0",
+                    (double)ph.sound_speed, c);
+        ph.sound_speed = (sph_real)c;
+    }
+    if (ph.eos == SPH_EOS_STIFFENED_GAS) {
+        SPH__PCHECK(ph.sound_speed > 0,
+                    "sph_phase.sound_speed = 0: a stiffened gas needs its sound speed at rest "
+                    "density (it sets p_inf)");
+        SPH__PCHECK(sph__pinf(&ph) >= 0,
+                    "sph_phase: a stiffened gas with rho0 c0^2 / gamma = %g Pa below its "
+                    "back_pressure %g Pa would have p_inf < 0; raise sound_speed or use an ideal gas",
+                    (double)(ph.rest_density * ph.sound_speed * ph.sound_speed / ph.gamma),
+                    (double)ph.back_pressure);
+    }
 #undef SPH__PCHECK
-    if (ph.gamma == 0) ph.gamma = 7;
+    if (gas && !w->priv.has_energy) { /* the internal energy array, from now on */
+        size_t i;
+        if (!sph__grow((void**)&w->e, w->capacity, sizeof(sph_real))) {
+            sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory for the internal energy array");
+            return -1;
+        }
+        for (i = 0; i < w->n; ++i) w->e[i] = 0;
+        w->priv.has_energy = 1;
+    }
     vol = (double)w->dx;
     if (w->dim >= 2) vol *= (double)w->dx;
     if (w->dim >= 3) vol *= (double)w->dx;
@@ -1839,12 +1957,24 @@ SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase) {
 }
 
 /* Appends n fluid particles of one phase and mass; x, v (NULL = 0) are validated by the caller. */
+static sph_real sph__eos_phase(const sph_phase* P, sph_real rho);
+
+/* Appends n fluid particles of one phase with the mass `mass` (or masses m[i]) and the rest
+   density (or densities rho[i]); x, v (NULL = 0), m and rho are validated by the caller. A gas
+   starts at its back pressure: e = (p_b + gamma p_inf) / ((gamma - 1) rho). */
 static sph_status sph__append_fluid(sph_world* w, int phase, size_t n, const sph_real* x,
-                                    const sph_real* v, sph_real mass) {
+                                    const sph_real* v, sph_real mass, const sph_real* m_in,
+                                    const sph_real* rho_in) {
     const size_t dim = (size_t)w->dim;
+    const sph_phase* P = &w->phases[phase];
+    const int gas = P->eos == SPH_EOS_IDEAL_GAS || P->eos == SPH_EOS_STIFFENED_GAS;
     size_t i, base = w->n;
     sph_status s;
-    int need_m = w->m == NULL && w->priv.have_mass && mass != w->mass;
+    int need_m = 0;
+    if (m_in && !w->priv.have_mass && n > 0) mass = m_in[0];
+    for (i = 0; m_in && i < n; ++i)
+        if (m_in[i] != mass) need_m = 1;
+    need_m = w->m == NULL && (need_m || (w->priv.have_mass && mass != w->mass));
     s = sph__reserve(w, 0, w->n + n);
     if (s != SPH_OK) return s;
     if (need_m) { /* particles of different masses: keep a mass per particle from now on */
@@ -1861,12 +1991,15 @@ static sph_status sph__append_fluid(sph_world* w, int phase, size_t n, const sph
             w->v[j * dim + k] = v ? v[i * dim + k] : 0;
             w->a[j * dim + k] = 0;
         }
-        w->rho[j] = w->phases[phase].rest_density;
-        w->p[j] = 0;
+        w->rho[j] = rho_in ? rho_in[i] : P->rest_density;
+        w->p[j] = gas || !rho_in ? P->back_pressure : sph__eos_phase(P, w->rho[j]);
         w->drho[j] = 0;
+        if (w->e)
+            w->e[j] = gas ? (P->back_pressure + P->gamma * sph__pinf(P)) / ((P->gamma - 1) * w->rho[j])
+                          : 0;
         w->id[j] = w->next_id++;
         w->phase[j] = (uint8_t)phase;
-        if (w->m) w->m[j] = mass;
+        if (w->m) w->m[j] = m_in ? m_in[i] : mass;
     }
     if (!w->priv.have_mass) { w->priv.have_mass = 1; w->mass = mass; }
     w->n += n;
@@ -1896,7 +2029,36 @@ SPHDEF sph_status sph_add_fluid(sph_world* w, int phase, size_t n, const sph_rea
         return sph__fail(w, SPH_ERR_ARG, (long)(bad / dim),
                          "sph_add_fluid: v of particle %zu is not finite (%g)", bad / dim,
                          (double)v[bad]);
-    return sph__append_fluid(w, phase, n, x, v, w->phases[phase].mass);
+    return sph__append_fluid(w, phase, n, x, v, w->phases[phase].mass, NULL, NULL);
+}
+
+SPHDEF sph_status sph_add_fluid_ex(sph_world* w, int phase, size_t n, const sph_real* x,
+                                   const sph_real* v, const sph_real* m, const sph_real* rho) {
+    size_t bad = 0, dim;
+    if (!w) return SPH_ERR_ARG;
+    if (!sph__check_phase(w, phase)) return SPH_ERR_ARG;
+    if (n == 0) return SPH_OK;
+    if (!x) return sph__fail(w, SPH_ERR_ARG, -1, "sph_add_fluid_ex: x is NULL");
+    dim = (size_t)w->dim;
+    if (!sph__all_finite(x, n * dim, &bad))
+        return sph__fail(w, SPH_ERR_ARG, (long)(bad / dim),
+                         "sph_add_fluid_ex: x of particle %zu is not finite (%g)", bad / dim,
+                         (double)x[bad]);
+    if (v && !sph__all_finite(v, n * dim, &bad))
+        return sph__fail(w, SPH_ERR_ARG, (long)(bad / dim),
+                         "sph_add_fluid_ex: v of particle %zu is not finite (%g)", bad / dim,
+                         (double)v[bad]);
+    for (bad = 0; m && bad < n; ++bad)
+        if (!sph__finite((double)m[bad]) || !(m[bad] > 0))
+            return sph__fail(w, SPH_ERR_ARG, (long)bad,
+                             "sph_add_fluid_ex: mass of particle %zu is %g: must be finite and > 0",
+                             bad, (double)m[bad]);
+    for (bad = 0; rho && bad < n; ++bad)
+        if (!sph__finite((double)rho[bad]) || !(rho[bad] > 0))
+            return sph__fail(w, SPH_ERR_ARG, (long)bad,
+                             "sph_add_fluid_ex: density of particle %zu is %g: must be finite and > 0",
+                             bad, (double)rho[bad]);
+    return sph__append_fluid(w, phase, n, x, v, w->phases[phase].mass, m, rho);
 }
 
 static sph_status sph__check_box(sph_world* w, const char* fn, const sph_real* lo,
@@ -1952,7 +2114,7 @@ SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, cons
     for (k = 0; k < dim; ++k)
         if (sp[k] != w->dx) break;
     s = sph__append_fluid(w, phase, total, pts, NULL,
-                          k == dim ? w->phases[phase].mass : (sph_real)mass);
+                          k == dim ? w->phases[phase].mass : (sph_real)mass, NULL, NULL);
     SPH_FREE(pts);
     return s;
 }
@@ -2120,7 +2282,7 @@ SPHDEF size_t sph_world_memory(const sph_world* w) {
     bytes += w->priv.perm_cap + w->priv.block_cap * sizeof(double) +
              (w->priv.rho_n_cap + w->priv.aii_cap + w->priv.src_cap + w->priv.ap_cap +
               w->priv.ff_fw_cap + w->priv.fb_fw_cap + w->priv.pr2_cap + w->priv.xp_cap +
-              w->priv.vp_cap) *
+              w->priv.vp_cap + w->priv.de_cap + w->priv.cs_cap + w->priv.vn_cap + w->priv.bpq_cap) *
                  sizeof(sph_real);
     return bytes;
 }
@@ -2154,10 +2316,32 @@ SPHDEF void sph_world_momentum(const sph_world* w, double* out) {
    flows; for one phase and lattice walls (V_b = dx^d) it is Adami et al.'s dummy particle. */
 
 /* Tait or linear equation of state per phase, with the constants prepared once per step. */
+/* For the gases B = rho0 c0^2 / gamma = p_b + p_inf too: along their isentrope through the rest
+   state, p + p_inf = (p_b + p_inf)(rho/rho0)^gamma is the Tait law, so sph__eos_inverse serves
+   walls and hydrostatic columns of every phase. */
 typedef struct sph__phase_c {
     sph_real rho0, inv_rho0, c0, B, inv_B, gamma, inv_gamma, pb, mu;
-    int eos, gamma7;
+    sph_real pinf; /* stiffened gas p_inf [Pa]                                                  */
+    sph_real ck;   /* c^2 = gamma (p + ck) / rho: B - p_b (Tait), p_inf (gases)                  */
+    int eos, gamma7, gas;
 } sph__phase_c;
+
+static void sph__phase_c_init(sph__phase_c* C, const sph_phase* P) {
+    C->rho0 = P->rest_density;
+    C->inv_rho0 = 1 / P->rest_density;
+    C->c0 = P->sound_speed;
+    C->gamma = P->gamma;
+    C->inv_gamma = 1 / P->gamma;
+    C->gamma7 = P->gamma == 7;
+    C->B = P->rest_density * P->sound_speed * P->sound_speed / P->gamma;
+    C->inv_B = C->B > 0 ? 1 / C->B : 0;
+    C->pb = P->back_pressure;
+    C->eos = (int)P->eos;
+    C->gas = P->eos == SPH_EOS_IDEAL_GAS || P->eos == SPH_EOS_STIFFENED_GAS;
+    C->pinf = sph__pinf(P);
+    C->ck = C->gas ? C->pinf : C->B - C->pb;
+    C->mu = P->rest_density * P->viscosity; /* dynamic viscosity [Pa s] */
+}
 
 SPH__INLINE sph_real sph__eos(const sph__phase_c* P, sph_real rho) {
     sph_real t = rho * P->inv_rho0;
@@ -2167,6 +2351,13 @@ SPH__INLINE sph_real sph__eos(const sph__phase_c* P, sph_real rho) {
         return P->B * (t4 * t2 * t - 1) + P->pb;
     }
     return P->B * (sph__pow(t, P->gamma) - 1) + P->pb;
+}
+
+/* The Tait or linear pressure of a phase at density rho (outside the stages). */
+static sph_real sph__eos_phase(const sph_phase* P, sph_real rho) {
+    sph__phase_c C;
+    sph__phase_c_init(&C, P);
+    return sph__eos(&C, rho);
 }
 
 /* rho/rho0 for pressure p: the inverse of sph__eos. Tension beyond what the fluid can carry is
@@ -2193,6 +2384,8 @@ typedef struct sph__ctx {
     sph_real m0;
     const uint8_t* ph;
     const sph_real *bx, *bv, *bvw, *bvol, *bp, *brho;
+    sph_real* bpq;             /* if set: per wall particle and phase (p_b, rho_b/rho0), see
+                                  sph__stage_wall; the fluid sees its own phase's values       */
     sph__phase_c pc[SPH_MAX_PHASES];
     const sph_neighbors *ff, *fb, *bf;
     int density, pgrad, noslip, laminar, morris, av, delta_on;
@@ -2204,7 +2397,22 @@ typedef struct sph__ctx {
                                   average of the fluid's (solvers without one, seed 000 sec. 3.2.3) */
     sph_real alpha, beta, delta, visc_k;
     sph_real g[3];
+    /* the compressible step */
+    const sph_real* e;         /* specific internal energy (NULL without gas phases)             */
+    const sph_real* cs;        /* per-particle sound speed for artificial viscosity (else c0)    */
+    const sph_real* vn;        /* velocities at the start of the step (SPH__ENERGY passes)       */
+    sph_real* de;              /* energy rate output of SPH__ENERGY passes [J/kg/s]              */
 } sph__ctx;
+
+/* Multiphase walls with an equation of state extrapolate one wall pressure per phase: Adami et
+   al.'s eq. 27 over all fluid neighbours would carry the dense phase's hydrostatic gradient
+   across the interface (at 1000:1 a wall particle beside the air, one spacing above the water,
+   gets -rho_w g dx, hundreds of pascals below the air's pressure, and pulls the air into the
+   wall). Each phase sees the wall extrapolated from its own particles only. */
+static int sph__phase_walls(const sph_world* w) {
+    return w->nphase > 1 && w->nb > 0 && w->def.boundary_pressure == SPH_BP_EXTRAPOLATE &&
+           (w->priv.solver == SPH_SOLVER_WCSPH || w->priv.solver == SPH_SOLVER_COMPRESSIBLE);
+}
 
 static void sph__ctx_init(sph_world* w, sph__ctx* c) {
     int k, q;
@@ -2229,26 +2437,21 @@ static void sph__ctx_init(sph_world* w, sph__ctx* c) {
     c->nphase = w->nphase;
     c->laminar = 0;
     for (q = 0; q < w->nphase; ++q) {
-        const sph_phase* P = &w->phases[q];
-        sph__phase_c* C = &c->pc[q];
-        C->rho0 = P->rest_density;
-        C->inv_rho0 = 1 / P->rest_density;
-        C->c0 = P->sound_speed;
-        C->gamma = P->gamma;
-        C->inv_gamma = 1 / P->gamma;
-        C->gamma7 = P->gamma == 7;
-        C->B = P->rest_density * P->sound_speed * P->sound_speed / P->gamma;
-        C->inv_B = C->B > 0 ? 1 / C->B : 0;
-        C->pb = P->back_pressure;
-        C->eos = (int)P->eos;
-        C->mu = P->rest_density * P->viscosity; /* dynamic viscosity [Pa s] */
-        if (P->viscosity > 0) c->laminar = 1;
+        sph__phase_c_init(&c->pc[q], &w->phases[q]);
+        if (w->phases[q].viscosity > 0) c->laminar = 1;
     }
     c->density = (int)w->def.density;
     c->pgrad = (int)w->def.pressure_grad;
     c->noslip = w->def.wall == SPH_WALL_NO_SLIP;
     c->bp_mode = (int)w->def.boundary_pressure;
-    c->eos_walls = w->def.solver == SPH_SOLVER_WCSPH;
+    c->eos_walls = w->priv.solver == SPH_SOLVER_WCSPH || w->priv.solver == SPH_SOLVER_COMPRESSIBLE;
+    c->bpq = sph__phase_walls(w) ? w->priv.bpq : NULL;
+    if (w->priv.solver == SPH_SOLVER_COMPRESSIBLE) {
+        c->e = w->e;
+        c->cs = w->priv.cs;
+        c->vn = w->priv.vn;
+        c->de = w->priv.de;
+    }
     c->morris = w->def.viscosity_form == SPH_VISC_MORRIS;
     c->alpha = w->def.alpha;
     c->beta = w->def.beta;
@@ -2296,9 +2499,10 @@ static void sph__stage_wall(sph_world* w, const sph__ctx* c, int parts) {
         const size_t bD = (size_t)b * (size_t)D;
         const sph_real* xb = c->bx + bD;
         sph_real sw = 0, swp = 0, sgx = 0, srr = 0, sv[3] = {0, 0, 0}, wph[SPH_MAX_PHASES];
+        sph_real qp[SPH_MAX_PHASES], qg[SPH_MAX_PHASES];
         size_t kk, k0 = nl->begin[b], k1 = k0 + nl->count[b];
         int k, q;
-        for (q = 0; q < c->nphase; ++q) wph[q] = 0;
+        for (q = 0; q < c->nphase; ++q) wph[q] = qp[q] = qg[q] = 0;
         for (kk = k0; kk < k1; ++kk) {
             const size_t f = nl->idx[kk], fD = f * (size_t)D;
             sph_real d[3] = {0, 0, 0}, r2 = 0, W;
@@ -2311,6 +2515,11 @@ static void sph__stage_wall(sph_world* w, const sph__ctx* c, int parts) {
                 for (k = 0; k < D; ++k) /* rho_f (g_f - a_b) . x_bf W_bf */
                     sgx += c->rho[f] * (w->a[fD + (size_t)k] - w->b_a[bD + (size_t)k]) * d[k] * W;
                 wph[c->ph[f]] += W;
+                if (c->bpq) { /* the same sums per phase */
+                    qp[c->ph[f]] += c->p[f] * W;
+                    for (k = 0; k < D; ++k)
+                        qg[c->ph[f]] += c->rho[f] * (w->a[fD + (size_t)k] - w->b_a[bD + (size_t)k]) * d[k] * W;
+                }
             }
             if (parts & SPH__WALL_STATE) {
                 for (k = 0; k < D; ++k) sv[k] += c->v[fD + (size_t)k] * W;
@@ -2337,6 +2546,13 @@ static void sph__stage_wall(sph_world* w, const sph__ctx* c, int parts) {
                 w->b_rho[b] = 1;
             }
             w->b_p[b] = pb;
+            if (c->bpq) /* per phase; a phase without neighbours here is never asked */
+                for (q = 0; q < c->nphase; ++q) {
+                    const sph_real pq = wph[q] > 0 ? (qp[q] + qg[q]) / wph[q] : pb;
+                    c->bpq[((size_t)b * (size_t)c->nphase + (size_t)q) * 2] = pq;
+                    c->bpq[((size_t)b * (size_t)c->nphase + (size_t)q) * 2 + 1] =
+                        sph__eos_inverse(&c->pc[q], pq);
+                }
         }
     }
 }
@@ -2363,7 +2579,7 @@ static sph_status sph__resolve_sound_speed(sph_world* w) {
     for (q = 0; q < w->nphase; ++q) {
         double smin = 1e300, smax = -1e300, v2max = 0, U, c0;
         size_t i, count = 0;
-        if (w->phases[q].sound_speed > 0) continue;
+        if (w->phases[q].sound_speed > 0 || w->phases[q].eos == SPH_EOS_IDEAL_GAS) continue;
         for (i = 0; i < w->n; ++i) {
             double s = 0, v2 = 0;
             if (w->phase[i] != q) continue;
@@ -2464,19 +2680,26 @@ SPHDEF sph_status sph_set_hydrostatic(sph_world* w) {
         while (b < w->n && it[b].bin[0] == it[a].bin[0] && it[b].bin[1] == it[a].bin[1]) ++b;
         for (i = a; i < b; ++i) {
             size_t j = it[i].i;
+            const sph__phase_c* P = &c.pc[w->phase[j]];
             double rho0 = (double)w->phases[w->phase[j]].rest_density;
-            if (i == a) p = rho0 * gmag * 0.5 * (double)w->dx;
+            /* the column's top phase sets the ambient pressure: its back pressure */
+            if (i == a) p = (double)w->phases[w->phase[j]].back_pressure + rho0 * gmag * 0.5 * (double)w->dx;
             else {
                 size_t jp = it[i - 1].i;
                 double rho0p = (double)w->phases[w->phase[jp]].rest_density;
                 p += gmag * 0.5 * (rho0 + rho0p) * (it[i - 1].s - it[i].s);
             }
             w->p[j] = (sph_real)p;
-            /* weakly compressible: the density the equation of state gives that pressure;
+            /* weakly compressible: the density the equation of state gives that pressure (a
+               gas: on the isentrope through its rest state, and the matching internal energy);
                incompressible solvers: the rest density */
-            w->rho[j] = w->def.solver == SPH_SOLVER_WCSPH
-                            ? c.pc[w->phase[j]].rho0 * sph__eos_inverse(&c.pc[w->phase[j]], (sph_real)p)
-                            : c.pc[w->phase[j]].rho0;
+            if (w->def.solver == SPH_SOLVER_WCSPH || w->def.solver == SPH_SOLVER_COMPRESSIBLE) {
+                w->rho[j] = P->rho0 * sph__eos_inverse(P, (sph_real)p);
+                if (P->gas)
+                    w->e[j] = (w->p[j] + P->gamma * P->pinf) / ((P->gamma - 1) * w->rho[j]);
+            } else {
+                w->rho[j] = P->rho0;
+            }
         }
         a = b;
     }
@@ -2495,6 +2718,10 @@ static sph_status sph__scratch(sph_world* w, sph_real** p, size_t count) {
                   : p == &w->priv.pr2   ? &w->priv.pr2_cap
                   : p == &w->priv.xp    ? &w->priv.xp_cap
                   : p == &w->priv.vp    ? &w->priv.vp_cap
+                  : p == &w->priv.de    ? &w->priv.de_cap
+                  : p == &w->priv.cs    ? &w->priv.cs_cap
+                  : p == &w->priv.vn    ? &w->priv.vn_cap
+                  : p == &w->priv.bpq   ? &w->priv.bpq_cap
                                         : NULL;
     SPH_ASSERT(cap);
     if (count <= *cap && *p) return SPH_OK;
@@ -2675,6 +2902,20 @@ static void sph__stage_eos(sph_world* w, const sph__ctx* c) {
     const int clamp = w->def.clamp == SPH_CLAMP_ON ||
                       (w->def.clamp == SPH_CLAMP_AUTO && w->def.density == SPH_DENSITY_SUMMATION);
     sph__idx i;
+    if (c->cs) { /* compressible step: gases from (rho, e), and every particle's sound speed */
+        SPH__OMP_FOR(w->n)
+        for (i = 0; i < (sph__idx)w->n; ++i) {
+            const sph__phase_c* P = &c->pc[c->ph[i]];
+            const sph_real rho = w->rho[i];
+            sph_real p, c2;
+            if (P->gas) p = (P->gamma - 1) * rho * c->e[i] - P->gamma * P->pinf;
+            else p = sph__eos(P, rho);
+            c2 = P->eos == SPH_EOS_LINEAR ? P->c0 * P->c0 : P->gamma * (p + P->ck) / rho;
+            w->priv.cs[i] = c2 > 0 ? sph__sqrt(c2) : 0;
+            w->p[i] = clamp && p < 0 ? 0 : p;
+        }
+        return;
+    }
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) {
         const sph_real p = sph__eos(&c->pc[c->ph[i]], w->rho[i]);
@@ -2683,8 +2924,10 @@ static void sph__stage_eos(sph_world* w, const sph__ctx* c) {
 }
 
 /* What a pass of the neighbour loop computes: pressure acceleration, viscous acceleration,
-   density rate; SET overwrites the acceleration output instead of adding to it. */
-enum { SPH__PRESSURE = 1, SPH__VISCOUS = 2, SPH__RATE = 4, SPH__SET = 8, SPH__CACHED = 16 };
+   density rate; SET overwrites the acceleration output instead of adding to it; ENERGY (with
+   PRESSURE, VISCOUS and RATE) computes the internal energy rate instead of an acceleration. */
+enum { SPH__PRESSURE = 1, SPH__VISCOUS = 2, SPH__RATE = 4, SPH__SET = 8, SPH__CACHED = 16,
+       SPH__ENERGY = 32 };
 #define SPH__ACCEL (SPH__PRESSURE | SPH__VISCOUS)
 
 /* The one neighbour loop for accelerations and the density rate of fluid particle i.
@@ -2698,37 +2941,62 @@ enum { SPH__PRESSURE = 1, SPH__VISCOUS = 2, SPH__RATE = 4, SPH__SET = 8, SPH__CA
           seed 000 eq. 2.5, 2(d+2) sum_j m_j nu_bar/rho_bar v_ij.x_ij/(r^2+eta^2) grad W, which
           conserves angular momentum but needs the fourth moment: 0.80 of nu Lap v on the same
           lattice) and Monaghan 1992 artificial viscosity Pi_ij = (-alpha c_bar mu_ij +
-          beta mu_ij^2)/rho_bar, mu_ij = h v_ij.x_ij/(r^2+eta^2) when v_ij.x_ij < 0. [m/s^2]
+          beta mu_ij^2)/rho_bar, mu_ij = h v_ij.x_ij/(r^2+eta^2) when v_ij.x_ij < 0, c_bar the
+          mean of the phases' c0 (of the particles' own sound speeds in the compressible step).
+          [m/s^2]
    RATE:  continuity d rho_i/dt = sum_j m_j v_ij . grad W_ij (seed 000 eq. 2.2), or m_i in place
           of m_j (Ott & Schnetter eq. 11), plus delta-SPH diffusion (Molteni & Colagrossi 2009,
           seed 000 sec. 3.2.1) written with densities relative to each phase's rest density:
           delta h c0 sum_j 2 rho0_i V_j (rho_i/rho0_i - rho_j/rho0_j) x_ij.grad W_ij/(r^2+eta^2),
           which is seed 000's term for one phase and does not diffuse across a phase interface.
-          Walls enter with their own velocity (a moving wall compresses). [kg/m^3/s] */
+          Walls enter with their own velocity (a moving wall compresses). [kg/m^3/s]
+   ENERGY: every pairwise acceleration above is m_j f_ij with f_ij = -f_ji, so the work of the
+          pair goes half to each side: de_i/dt = -1/2 sum_j m_j f_ij . v_ij, which for pressure
+          and artificial viscosity is Ott & Schnetter's eq. 13,
+              de_i/dt = 1/2 sum_j m_j (P_ij + Pi_ij) v_ij . grad W_ij   [J/kg/s],
+          P_ij the pressure term of the chosen gradient form. The forces are those of the
+          force pass (velocities c->vn, pressures unchanged since), dotted with the mean
+          velocity of the step (vn + v)/2: then the internal energy gains exactly the kinetic
+          energy the kick took, and total energy is conserved to round-off. The density rate of
+          the same pass uses the new velocity v (see the WCSPH step for why). */
+/* Hu & Adams' pair term of SPH_PGRAD_INTERFACE: -(V_i^2 + V_j^2)/m_i p_ij, the factor of
+   grad W_ij in the acceleration of i. */
+SPH__INLINE sph_real sph__pgrad_interface(sph_real mi, sph_real rhoi, sph_real pi, sph_real mj,
+                                          sph_real rhoj, sph_real pj) {
+    const sph_real Vi = mi / rhoi, Vj = mj / rhoj;
+    return -(Vi * Vi + Vj * Vj) / mi * (rhoj * pi + rhoi * pj) / (rhoi + rhoj);
+}
+
 SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, const int flags,
                                    sph_real* acc, sph_real* rate) {
+    const int en = (flags & SPH__ENERGY) != 0;
     const sph_real* xi = c->x + i * (size_t)D;
     const sph_real* vi = c->v + i * (size_t)D;
+    const sph_real* ui = en ? c->vn + i * (size_t)D : vi; /* velocity of the forces */
     const sph__phase_c* P = &c->pc[c->ph[i]];
     const sph_real rhoi = c->rho[i], pi = c->p[i], mi = c->m ? c->m[i] : c->m0;
     const sph_real inv_rhoi = 1 / rhoi, pi_r2 = pi * inv_rhoi * inv_rhoi;
     const sph_real rhati = rhoi * P->inv_rho0;
     const sph_real dcoef = c->delta * c->h * (c->delta_c > 0 ? c->delta_c : P->c0) * 2 * P->rho0;
+    const sph_real ci = c->cs ? c->cs[i] : P->c0;
     const int os = c->density == SPH_DENSITY_PARTICLE;
-    sph_real ai[3] = {0, 0, 0}, R = 0;
+    sph_real ai[3] = {0, 0, 0}, R = 0, E = 0;
     size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
     int k;
     for (kk = k0; kk < k1; ++kk) {
         const size_t j = c->ff->idx[kk];
         const sph_real* xj = c->x + j * (size_t)D;
         const sph_real* vj = c->v + j * (size_t)D;
+        const sph_real* uj = en ? c->vn + j * (size_t)D : vj;
         const sph_real mj = c->m ? c->m[j] : c->m0, rhoj = c->rho[j];
         const sph__phase_c* Pj = (flags & (SPH__VISCOUS | SPH__RATE)) ? &c->pc[c->ph[j]] : P;
-        sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, fw, s = 0;
+        sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, ud = 0, fw, s = 0, lm = 0;
         sph__delta_vec(c, xi, xj, d, D);
         for (k = 0; k < D; ++k) r2 += d[k] * d[k];
         if (flags & (SPH__VISCOUS | SPH__RATE))
             for (k = 0; k < D; ++k) vd += (vi[k] - vj[k]) * d[k];
+        ud = vd;
+        if (en) { ud = 0; for (k = 0; k < D; ++k) ud += (ui[k] - uj[k]) * d[k]; }
         if (flags & SPH__CACHED) fw = c->ff_fw[kk]; /* grad W = fw d */
         else fw = c->k.norm_g * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h);
         if (flags & SPH__RATE) {
@@ -2740,23 +3008,31 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
             const sph_real pj = c->p[j];
             if (c->pgrad == SPH_PGRAD_SYMMETRIC)
                 s = -mj * (pi_r2 + ((flags & SPH__CACHED) ? c->pr2[j] : pj / (rhoj * rhoj)));
-            else s = -mj * (pi + pj) * inv_rhoi / rhoj;
+            else if (c->pgrad == SPH_PGRAD_MULTIPHASE) s = -mj * (pi + pj) * inv_rhoi / rhoj;
+            else s = sph__pgrad_interface(mi, rhoi, pi, mj, rhoj, pj);
         }
         if (flags & SPH__VISCOUS) {
             if (c->laminar) {
                 const sph_real lv = c->visc_k * mj * (P->mu + Pj->mu) * inv_rhoi / rhoj / (r2 + c->eta2);
-                if (c->morris) /* along v_ij: x_ij . grad W = fw r^2 */
-                    for (k = 0; k < D; ++k) ai[k] += lv * fw * r2 * (vi[k] - vj[k]);
-                else
-                    s += lv * vd;
+                if (c->morris) { /* along v_ij: x_ij . grad W = fw r^2 */
+                    lm = lv * fw * r2;
+                    for (k = 0; k < D; ++k) ai[k] += lm * (ui[k] - uj[k]);
+                } else {
+                    s += lv * ud;
+                }
             }
-            if (c->av && vd < 0) {
-                const sph_real mu = c->h * vd / (r2 + c->eta2);
-                const sph_real cbar = SPH__R(0.5) * (P->c0 + Pj->c0);
+            if (c->av && ud < 0) {
+                const sph_real mu = c->h * ud / (r2 + c->eta2);
+                const sph_real cbar = SPH__R(0.5) * (ci + (c->cs ? c->cs[j] : Pj->c0));
                 s -= mj * (-c->alpha * cbar * mu + c->beta * mu * mu) * 2 / (rhoi + rhoj);
             }
         }
-        if (flags & SPH__ACCEL) {
+        if (en) { /* -1/2 m_j f_ij . (u_ij + v_ij)/2 */
+            sph_real uv = 0;
+            if (lm != 0)
+                for (k = 0; k < D; ++k) uv += (ui[k] - uj[k]) * (ui[k] - uj[k] + vi[k] - vj[k]);
+            E -= SPH__R(0.25) * (s * fw * (ud + vd) + lm * uv);
+        } else if (flags & SPH__ACCEL) {
             s *= fw;
             for (k = 0; k < D; ++k) ai[k] += s * d[k];
         }
@@ -2767,15 +3043,18 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
         for (kk = k0; kk < k1; ++kk) {
             const size_t b = c->fb->idx[kk];
             const sph_real* xb = c->bx + b * (size_t)D;
+            const sph_real* vb = c->bv + b * (size_t)D;
             const sph_real Vb = c->bvol[b], psi = P->rho0 * Vb;
             /* the wall's density and pressure as the boundary scheme gives them */
-            const sph_real kap = c->bp_mode == SPH_BP_EXTRAPOLATE ? c->brho[b] : rhati;
+            const sph_real* bq = c->bpq ? c->bpq + ((size_t)b * (size_t)c->nphase + c->ph[i]) * 2 : NULL;
+            const sph_real kap = bq ? bq[1] : c->bp_mode == SPH_BP_EXTRAPOLATE ? c->brho[b] : rhati;
             const sph_real rhob = P->rho0 * kap;
-            sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, fw, s = 0;
+            sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, ud = 0, fw, s = 0, lm = 0, ug = 0;
             sph__delta_vec(c, xi, xb, d, D);
             for (k = 0; k < D; ++k) r2 += d[k] * d[k];
             if (flags & SPH__RATE)
-                for (k = 0; k < D; ++k) vd += (vi[k] - c->bv[b * (size_t)D + (size_t)k]) * d[k];
+                for (k = 0; k < D; ++k) vd += (vi[k] - vb[k]) * d[k];
+            if (en) for (k = 0; k < D; ++k) ud += (ui[k] - vb[k]) * d[k];
             if (flags & SPH__CACHED) fw = c->fb_fw[kk];
             else fw = c->k.norm_g * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h);
             if (flags & SPH__RATE) {
@@ -2783,35 +3062,44 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
                 if (c->delta_on) R += dcoef * Vb * (rhati - kap) * fw * r2 / (r2 + c->eta2);
             }
             if (flags & SPH__PRESSURE) {
-                const sph_real pb = c->bp_mode == SPH_BP_EXTRAPOLATE ? c->bp[b]
+                const sph_real pb = bq ? bq[0] : c->bp_mode == SPH_BP_EXTRAPOLATE ? c->bp[b]
                                     : c->bp_mode == SPH_BP_MIRROR    ? pi
                                                                      : 0;
                 if (c->pgrad == SPH_PGRAD_SYMMETRIC) s = -psi * (pi_r2 + pb / (rhob * rhob));
-                else s = -psi * (pi + pb) * inv_rhoi / rhob;
+                else if (c->pgrad == SPH_PGRAD_MULTIPHASE) s = -psi * (pi + pb) * inv_rhoi / rhob;
+                else s = sph__pgrad_interface(mi, rhoi, pi, psi, rhob, pb);
             }
             if ((flags & SPH__VISCOUS) && c->noslip && (c->laminar || c->av)) {
-                sph_real vg = 0;
-                for (k = 0; k < D; ++k) vg += (vi[k] - c->bvw[b * (size_t)D + (size_t)k]) * d[k];
+                const sph_real* vw = c->bvw + b * (size_t)D;
+                for (k = 0; k < D; ++k) ug += (ui[k] - vw[k]) * d[k];
                 if (c->laminar) {
                     const sph_real lv = c->visc_k * psi * 2 * P->mu * inv_rhoi / rhob / (r2 + c->eta2);
-                    if (c->morris)
-                        for (k = 0; k < D; ++k)
-                            ai[k] += lv * fw * r2 * (vi[k] - c->bvw[b * (size_t)D + (size_t)k]);
-                    else
-                        s += lv * vg;
+                    if (c->morris) {
+                        lm = lv * fw * r2;
+                        for (k = 0; k < D; ++k) ai[k] += lm * (ui[k] - vw[k]);
+                    } else {
+                        s += lv * ug;
+                    }
                 }
-                if (c->av && vg < 0) {
-                    const sph_real mu = c->h * vg / (r2 + c->eta2);
-                    s -= psi * (-c->alpha * P->c0 * mu + c->beta * mu * mu) * 2 / (rhoi + rhob);
+                if (c->av && ug < 0) {
+                    const sph_real mu = c->h * ug / (r2 + c->eta2);
+                    s -= psi * (-c->alpha * ci * mu + c->beta * mu * mu) * 2 / (rhoi + rhob);
                 }
             }
-            if (flags & SPH__ACCEL) {
+            if (en) { /* as for fluid pairs, with the wall's velocity (walls take no energy) */
+                sph_real uv = 0;
+                if (lm != 0)
+                    for (k = 0; k < D; ++k)
+                        uv += (ui[k] - c->bvw[b * (size_t)D + (size_t)k]) * (ui[k] + vi[k] - 2 * vb[k]);
+                E -= SPH__R(0.25) * (s * fw * (ud + vd) + lm * uv);
+            } else if (flags & SPH__ACCEL) {
                 s *= fw;
                 for (k = 0; k < D; ++k) ai[k] += s * d[k];
             }
         }
     }
-    if (flags & SPH__SET)
+    if (en) c->de[i] = E;
+    else if (flags & SPH__SET)
         for (k = 0; k < D; ++k) acc[i * (size_t)D + (size_t)k] = ai[k];
     else if (flags & SPH__ACCEL) /* acc holds the body acceleration already */
         for (k = 0; k < D; ++k) acc[i * (size_t)D + (size_t)k] += ai[k];
@@ -2833,13 +3121,15 @@ static void sph__stage_interact(sph_world* w, const sph__ctx* c, int flags, sph_
         size_t i;
 #define SPH__LOOP(D, FL) for (i = i0; i < i1; ++i) sph__interact_one(c, i, D, FL, acc, w->drho)
 #define SPH__CASES(D)                                                                              \
-    case D * 32 + SPH__ACCEL: SPH__LOOP(D, SPH__ACCEL); break;                                     \
-    case D * 32 + SPH__VISCOUS: SPH__LOOP(D, SPH__VISCOUS); break;                                 \
-    case D * 32 + (SPH__PRESSURE | SPH__SET): SPH__LOOP(D, SPH__PRESSURE | SPH__SET); break;       \
-    case D * 32 + (SPH__PRESSURE | SPH__SET | SPH__CACHED):                                          \
+    case D * 64 + SPH__ACCEL: SPH__LOOP(D, SPH__ACCEL); break;                                     \
+    case D * 64 + SPH__VISCOUS: SPH__LOOP(D, SPH__VISCOUS); break;                                 \
+    case D * 64 + (SPH__PRESSURE | SPH__SET): SPH__LOOP(D, SPH__PRESSURE | SPH__SET); break;       \
+    case D * 64 + (SPH__PRESSURE | SPH__SET | SPH__CACHED):                                          \
         SPH__LOOP(D, SPH__PRESSURE | SPH__SET | SPH__CACHED); break;                               \
-    case D * 32 + SPH__RATE: SPH__LOOP(D, SPH__RATE); break;
-        switch (c->dim * 32 + flags) {
+    case D * 64 + SPH__RATE: SPH__LOOP(D, SPH__RATE); break;                                       \
+    case D * 64 + (SPH__RATE | SPH__ACCEL | SPH__ENERGY):                                          \
+        SPH__LOOP(D, SPH__RATE | SPH__ACCEL | SPH__ENERGY); break;
+        switch (c->dim * 64 + flags) {
             SPH__CASES(1)
             SPH__CASES(2)
             SPH__CASES(3)
@@ -2892,6 +3182,10 @@ static sph_status sph__check_step_input(sph_world* w, sph_real dt) {
             return sph__fail(w, SPH_ERR_ARG, (long)i,
                              "step: fluid particle %zu (id %u) has density %g: must be finite and > 0",
                              i, (unsigned)w->id[i], (double)w->rho[i]);
+        if (w->e && !sph__finite((double)w->e[i]))
+            return sph__fail(w, SPH_ERR_ARG, (long)i,
+                             "step: fluid particle %zu (id %u) has a non-finite internal energy", i,
+                             (unsigned)w->id[i]);
     }
     for (i = 0; i < w->nb * D; ++i)
         if (!sph__finite((double)w->b_x[i]) || !sph__finite((double)w->b_v[i]))
@@ -2921,7 +3215,8 @@ static sph_status sph__boundary_motion(sph_world* w, double t) {
    combined in block order, so the result does not depend on the number of threads. */
 enum { SPH__RED_KE, SPH__RED_ERRSUM, SPH__RED_ERRMAX, SPH__RED_COMP, SPH__RED_V2MAX,
        SPH__RED_A2MAX, SPH__RED_OUT, SPH__RED_BAD, SPH__RED_KIND, SPH__RED_N };
-enum { SPH__BAD_NONE, SPH__BAD_NONFINITE, SPH__BAD_DENSITY, SPH__BAD_COMPRESSION, SPH__BAD_SPEED };
+enum { SPH__BAD_NONE, SPH__BAD_NONFINITE, SPH__BAD_DENSITY, SPH__BAD_COMPRESSION, SPH__BAD_SPEED,
+       SPH__BAD_ENERGY };
 
 static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph_real* acc,
                                       sph_real kv, sph_real kr, sph_real kx, int final) {
@@ -2935,6 +3230,10 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
     if (vlim <= 0) {
         int ph;
         for (ph = 0; ph < w->nphase; ++ph) vlim = sph__max(vlim, w->phases[ph].sound_speed);
+        /* the compressible step is for flows near and above the speed of sound (a shock's
+           piston, an expansion into vacuum reaches 2 c0/(gamma - 1) = 5 c0 for air): there
+           only a runaway is a blow-up */
+        if (w->priv.solver == SPH_SOLVER_COMPRESSIBLE) vlim *= 10;
     }
     if (nblk * SPH__RED_N > w->priv.block_cap) {
         size_t cap = nblk * SPH__RED_N + 64;
@@ -2979,9 +3278,16 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                     out = 1;
             }
             err = (double)(w->rho[i] * c->pc[w->phase[i]].inv_rho0) - 1;
-            if (!sph__finite(v2) || !sph__finite((double)w->rho[i])) bad = SPH__BAD_NONFINITE;
+            if (!sph__finite(v2) || !sph__finite((double)w->rho[i]) ||
+                (c->e && !sph__finite((double)c->e[i])))
+                bad = SPH__BAD_NONFINITE;
             else if (!(w->rho[i] > 0)) bad = SPH__BAD_DENSITY;
-            else if (w->def.max_compression > 0 && err > (double)w->def.max_compression)
+            /* a gas compresses freely (a shock by (gamma + 1)/(gamma - 1)), but its sound speed
+               must stay real: p + p_inf >= 0, i.e. rho e >= p_inf */
+            else if (c->pc[w->phase[i]].gas && c->e && w->rho[i] * c->e[i] < c->pc[w->phase[i]].pinf)
+                bad = SPH__BAD_ENERGY;
+            else if (w->def.max_compression > 0 && err > (double)w->def.max_compression &&
+                     !c->pc[w->phase[i]].gas)
                 bad = SPH__BAD_COMPRESSION;
             else if (vlim > 0 && v2 > (double)vlim * (double)vlim) bad = SPH__BAD_SPEED;
             r[SPH__RED_KE] += 0.5 * mi * v2;
@@ -3044,6 +3350,13 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                              "sound speed too low",
                              (unsigned long long)w->steps, w->time, i, (unsigned)w->id[i], rr,
                              (double)w->def.max_compression);
+        case SPH__BAD_ENERGY:
+            return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
+                             "step %llu (t = %g s): fluid particle %zu (id %u) of a gas phase has "
+                             "internal energy %g J/kg at density %g: pressure below -p_inf, no "
+                             "real sound speed",
+                             (unsigned long long)w->steps, w->time, i, (unsigned)w->id[i],
+                             (double)c->e[i], (double)w->rho[i]);
         default:
             return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
                              "step %llu (t = %g s): fluid particle %zu (id %u) moves at %g m/s, "
@@ -3061,17 +3374,23 @@ static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, s
 }
 
 /* Common start of every step: input checks, automatic sound speeds, stats reset. */
-static sph_status sph__step_begin(sph_world* w, sph_real dt) {
+static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) {
     sph_status s;
     int k;
     if (!w) return SPH_ERR_ARG;
+    if (solver != SPH_SOLVER_COMPRESSIBLE)
+        for (k = 0; k < w->nphase; ++k)
+            if (w->phases[k].eos == SPH_EOS_IDEAL_GAS || w->phases[k].eos == SPH_EOS_STIFFENED_GAS)
+                return sph__fail(w, SPH_ERR_ARG, -1,
+                                 "step: phase %d has a gas equation of state, which needs the "
+                                 "internal energy only sph_step_compressible evolves", k);
     s = sph__check_step_input(w, dt);
     if (s != SPH_OK) return s;
     s = sph__resolve_sound_speed(w);
     if (s != SPH_OK) {
         /* an incompressible solver uses c0 only to scale artificial viscosity and the speed
            bound of the blow-up check: without one, both are off */
-        if (w->def.solver == SPH_SOLVER_WCSPH) return s;
+        if (solver == SPH_SOLVER_WCSPH || solver == SPH_SOLVER_COMPRESSIBLE) return s;
         w->status = SPH_OK;
         w->error[0] = 0;
     }
@@ -3082,6 +3401,8 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt) {
     w->error[0] = 0;
     w->error_index = -1;
     w->status = SPH_OK;
+    w->priv.solver = (int)solver;
+    if (sph__phase_walls(w)) return sph__scratch(w, &w->priv.bpq, w->nb * (size_t)w->nphase * 2);
     return SPH_OK;
 }
 
@@ -3217,7 +3538,7 @@ static sph_status sph__step_end(sph_world* w, sph_status s) {
 }
 
 SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt) {
-    sph_status s = sph__step_begin(w, dt);
+    sph_status s = sph__step_begin(w, dt, SPH_SOLVER_WCSPH);
     if (s != SPH_OK) return s;
     if (w->def.integrator == SPH_INTEGRATOR_VERLET) return sph__step_end(w, sph__step_wcsph_verlet(w, dt));
     return sph__step_end(w, sph__step_wcsph_euler(w, dt));
@@ -3508,7 +3829,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
 }
 
 SPHDEF sph_status sph_step_pcisph(sph_world* w, sph_real dt) {
-    sph_status s = sph__step_begin(w, dt);
+    sph_status s = sph__step_begin(w, dt, SPH_SOLVER_PCISPH);
     if (s != SPH_OK) return s;
     return sph__step_end(w, sph__step_pcisph(w, dt));
 }
@@ -3744,9 +4065,80 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
 }
 
 SPHDEF sph_status sph_step_iisph(sph_world* w, sph_real dt) {
-    sph_status s = sph__step_begin(w, dt);
+    sph_status s = sph__step_begin(w, dt, SPH_SOLVER_IISPH);
     if (s != SPH_OK) return s;
     return sph__step_end(w, sph__step_iisph(w, dt));
+}
+
+/* ============================================================================================== */
+/* >>compressible (implementation)                                                                */
+/* ============================================================================================== */
+/* Explicit compressible multiphase SPH (Ott & Schnetter 2003, seed 004). Symplectic Euler as in
+   the WCSPH step, with an internal energy that conserves the total energy:
+       a^n       = g + a(x^n, rho^n, e^n, v^n)                 eq. 12 + artificial viscosity
+       v^{n+1}   = v^n + dt a^n
+       rho^{n+1} = rho^n + dt R(x^n, v^{n+1})                  eq. 11 (def.density: or 8, or 7)
+       e^{n+1}   = e^n + dt E(x^n, rho^n, e^n; v^n, v^{n+1})   eq. 13, forces of a^n dotted with
+                                                               the step's mean velocity
+       x^{n+1}   = x^n + dt v^{n+1}
+   The kinetic energy changes by sum_i m_i dt a_i . (v^n + v^{n+1})/2 exactly, and E returns
+   exactly that (sph__interact_one, ENERGY), so kinetic + internal energy is conserved to
+   round-off by any dt (tests/test_compressible.c). The density takes the new velocity (stable
+   acoustics, see >>wcsph); the energy's mean velocity differs from it by dt a/2, an O(dt)
+   entropy error per unit time in smooth flow (the sound-pulse test bounds its effect).
+   Decisions where seed 004 is silent: its artificial viscosity is Monaghan's (1992) with the
+   particles' own sound speeds in c_bar and beta left to def.beta (its shock tube needs only alpha);
+   walls are Adami walls whose density follows each phase's isentrope through its rest state;
+   phases with the Tait or linear law keep them and their energy is evolved but unused. Two
+   neighbour passes per step: forces, then density and energy rates. */
+static sph_status sph__step_compressible(sph_world* w, sph_real dt) {
+    const int cont = w->def.density != SPH_DENSITY_SUMMATION;
+    const size_t D = (size_t)w->dim;
+    double t0 = sph__now(), tstart = t0;
+    sph__ctx c;
+    sph_status s;
+    sph__idx i;
+    s = sph__scratch(w, &w->priv.cs, w->capacity);
+    if (s == SPH_OK) s = sph__scratch(w, &w->priv.vn, w->capacity * D);
+    if (s == SPH_OK) s = sph__scratch(w, &w->priv.de, w->capacity);
+    if (s != SPH_OK) return s;
+    s = sph__prepare_forces(w, &c, w->time, &t0); /* also p(rho, e) and the sound speeds */
+    if (s != SPH_OK) return s;
+    sph__stage_interact(w, &c, SPH__ACCEL, w->a);
+    sph__time(w, SPH_STAGE_FORCES, &t0);
+    memcpy(w->priv.vn, w->v, w->n * D * sizeof(sph_real));
+    s = sph__integrate(w, &c, dt, 0, 0, 0); /* kick */
+    if (s != SPH_OK) return s;
+    if (w->e) {
+        sph__stage_interact(w, &c, SPH__RATE | SPH__ACCEL | SPH__ENERGY, NULL);
+        SPH__OMP_FOR(w->n)
+        for (i = 0; i < (sph__idx)w->n; ++i) w->e[i] += dt * w->priv.de[i];
+    } else if (cont) {
+        sph__stage_interact(w, &c, SPH__RATE, NULL);
+    }
+    sph__time(w, SPH_STAGE_DENSITY, &t0);
+    ++w->steps;
+    w->time += (double)dt;
+    s = sph__integrate(w, &c, 0, cont ? dt : 0, dt, 1); /* density and drift */
+    sph__time(w, SPH_STAGE_INTEGRATE, &t0);
+    w->stats.step_time = sph__now() - tstart;
+    return s;
+}
+
+SPHDEF sph_status sph_step_compressible(sph_world* w, sph_real dt) {
+    sph_status s = sph__step_begin(w, dt, SPH_SOLVER_COMPRESSIBLE);
+    if (s != SPH_OK) return s;
+    return sph__step_end(w, sph__step_compressible(w, dt));
+}
+
+/* Sound speed of a particle of phase P at density rho and specific internal energy e [m/s]. */
+static double sph__sound_speed(const sph_phase* P, double rho, double e) {
+    const double g = (double)P->gamma, c0 = (double)P->sound_speed;
+    double c2;
+    if (P->eos == SPH_EOS_LINEAR) return c0;
+    if (P->eos == SPH_EOS_TAIT) c2 = c0 * c0 * pow(rho / (double)P->rest_density, g - 1);
+    else c2 = (g - 1) * (e - (double)sph__pinf(P) / rho) * g; /* gamma (p + p_inf) / rho */
+    return c2 > 0 ? sqrt(c2) : 0;
 }
 
 /* >>stages: time step control */
@@ -3757,12 +4149,12 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
     size_t i, k;
     int q;
     if (!w) return 0;
-    if ((int)solver < 0 || solver > SPH_SOLVER_PCISPH) {
+    if ((int)solver < 0 || solver > SPH_SOLVER_COMPRESSIBLE) {
         sph__fail(w, SPH_ERR_ARG, -1, "sph_stable_dt: solver %d is not a sph_solver", (int)solver);
         return 0;
     }
     if (sph__resolve_sound_speed(w) != SPH_OK) {
-        if (solver == SPH_SOLVER_WCSPH) return 0;
+        if (solver == SPH_SOLVER_WCSPH || solver == SPH_SOLVER_COMPRESSIBLE) return 0;
         w->status = SPH_OK; /* incompressible solvers do not need c0 */
         w->error[0] = 0;
     }
@@ -3788,6 +4180,19 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
             return 0;
         }
         dt = (double)w->def.cfl * (double)w->h / (cmax + sqrt(v2max));
+    } else if (solver == SPH_SOLVER_COMPRESSIBLE) {
+        /* the acoustic CFL with each particle's sound speed now (a gas heats and cools); the
+           artificial viscosity of alpha <= 1 is a viscosity of about alpha c h / 8, whose own limit
+           (h / (alpha c)) lies far above this one */
+        double smax = 0;
+        for (i = 0; i < w->n; ++i) {
+            double v2 = 0, sp;
+            for (k = 0; k < D; ++k) v2 += (double)w->v[i * D + k] * (double)w->v[i * D + k];
+            sp = sph__sound_speed(&w->phases[w->phase[i]], (double)w->rho[i],
+                                  w->e ? (double)w->e[i] : 0) + sqrt(v2);
+            if (sp > smax) smax = sp;
+        }
+        if (smax > 0) dt = (double)w->def.cfl * (double)w->h / smax;
     } else if (v2max > 0) { /* seed 003 eq. 14: a particle moves at most cfl_velocity dx per step */
         dt = (double)w->def.cfl_velocity * (double)w->dx / sqrt(v2max);
     }
@@ -3815,6 +4220,7 @@ SPHDEF sph_status sph_step(sph_world* w, sph_real dt) {
     case SPH_SOLVER_WCSPH: return sph_step_wcsph(w, dt);
     case SPH_SOLVER_IISPH: return sph_step_iisph(w, dt);
     case SPH_SOLVER_PCISPH: return sph_step_pcisph(w, dt);
+    case SPH_SOLVER_COMPRESSIBLE: return sph_step_compressible(w, dt);
     default: return sph__fail(w, SPH_ERR_ARG, -1, "sph_step: unknown solver %d", (int)w->def.solver);
     }
 }
@@ -3867,12 +4273,14 @@ SPHDEF sph_status sph_write_csv(const sph_world* w, const char* path) {
     fprintf(f, "id,phase");
     for (k = 0; k < w->dim; ++k) fprintf(f, ",%c", names[k]);
     for (k = 0; k < w->dim; ++k) fprintf(f, ",v%c", names[k]);
-    fprintf(f, ",rho,p\n");
+    fprintf(f, w->e ? ",rho,p,e\n" : ",rho,p\n");
     for (i = 0; i < w->n; ++i) {
         fprintf(f, "%u,%u", (unsigned)w->id[i], (unsigned)w->phase[i]);
         for (k = 0; k < w->dim; ++k) fprintf(f, ",%.9g", (double)w->x[i * (size_t)w->dim + (size_t)k]);
         for (k = 0; k < w->dim; ++k) fprintf(f, ",%.9g", (double)w->v[i * (size_t)w->dim + (size_t)k]);
-        fprintf(f, ",%.9g,%.9g\n", (double)w->rho[i], (double)w->p[i]);
+        fprintf(f, ",%.9g,%.9g", (double)w->rho[i], (double)w->p[i]);
+        if (w->e) fprintf(f, ",%.9g", (double)w->e[i]);
+        fputc('\n', f);
     }
     return fclose(f) == 0 ? SPH_OK : SPH_ERR_ARG;
 }
@@ -3906,6 +4314,10 @@ SPHDEF sph_status sph_write_vtk(const sph_world* w, const char* path) {
     for (i = 0; i < n; ++i) fprintf(f, "%.9g\n", i < w->n ? (double)w->rho[i] : (double)w->b_rho[i - w->n]);
     fprintf(f, "SCALARS pressure double 1\nLOOKUP_TABLE default\n");
     for (i = 0; i < n; ++i) fprintf(f, "%.9g\n", i < w->n ? (double)w->p[i] : (double)w->b_p[i - w->n]);
+    if (w->e) {
+        fprintf(f, "SCALARS internal_energy double 1\nLOOKUP_TABLE default\n");
+        for (i = 0; i < n; ++i) fprintf(f, "%.9g\n", i < w->n ? (double)w->e[i] : 0.0);
+    }
     fprintf(f, "VECTORS velocity double\n");
     for (i = 0; i < n; ++i) {
         const sph_real* v = i < w->n ? w->v + i * (size_t)w->dim : w->b_v + (i - w->n) * (size_t)w->dim;
