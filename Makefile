@@ -4,6 +4,8 @@
 #   make examples  every example, each built with one cc command
 #   make check     warnings (gcc, clang, C, C++), sanitizers, float, no-OpenMP and C++ test runs
 #   make validate  the long validation runs (tests marked long)
+#   make bench     throughput (bench/bench.c) and the Taylor-Green convergence study
+#                  (bench/convergence.c), results in bench/results/; BENCH_N=40 for a quick run
 
 CC      ?= cc
 CXX     ?= c++
@@ -15,9 +17,9 @@ WARN     = -Wall -Wextra -Wpedantic -Wshadow
 CFLAGS  ?= $(OPT) -std=c99 $(WARN)
 B        = build
 
-TEST_SRC = tests/main.c tests/impl.c tests/test_kernels.c tests/test_grid.c \
+TEST_SRC = tests/main.c tests/impl.c tests/test_kernels.c tests/test_grid.c tests/test_operators.c \
            tests/test_world.c tests/test_wcsph.c tests/test_pcisph.c tests/test_iisph.c \
-           tests/test_compressible.c \
+           tests/test_compressible.c tests/test_soc.c \
            tests/test_compile.c \
            tests/compile_second.c \
            tests/compile_static.c
@@ -25,7 +27,7 @@ TEST_CXX = tests/compile_cpp.cpp
 TEST_DEP = sph.h tests/harness.h tests/riemann.h bench/svg.h examples/scenes.h $(TEST_SRC) $(TEST_CXX)
 EXAMPLES = hello dambreak
 
-.PHONY: test validate demo examples check check-warnings check-sanitize check-float check-noomp \
+.PHONY: test validate bench demo examples check check-warnings check-sanitize check-float check-noomp \
         check-cpp check-png clean
 
 test: $(B)/tests
@@ -38,6 +40,18 @@ $(B)/tests: $(TEST_DEP) | $(B)
 
 validate: $(B)/tests
 	./$(B)/tests --long -long/
+
+BENCH_N ?= 80
+bench: $(B)/bench $(B)/convergence
+	mkdir -p bench/results
+	./$(B)/bench dambreak2d 100 200 3 bench/results/throughput.csv
+	./$(B)/convergence $(BENCH_N) bench/results
+
+$(B)/bench: bench/bench.c sph.h examples/scenes.h | $(B)
+	$(CC) $(CFLAGS) $(OMP) -I. bench/bench.c -o $@ -lm
+
+$(B)/convergence: bench/convergence.c sph.h examples/scenes.h bench/svg.h | $(B)
+	$(CC) $(CFLAGS) $(OMP) -I. bench/convergence.c -o $@ -lm
 
 demo: $(B)/dambreak
 	./$(B)/dambreak

@@ -19,6 +19,7 @@
        >>types         sph_status
        >>kernels       sph_kernel: W, dW/dr, grad W (usable on their own)
        >>grid          sph_grid, sph_neighbors: cell grid and neighbour lists (on their own)
+       >>operators     sph_op_*: Bonet-Lok corrected gradient, divergence, Laplacian, shifting
        >>world         sph_world_def, sph_phase, sph_world: particles, walls, phases
        >>boundaries    wall particles: Adami pressure extrapolation, no-slip
        >>stages        the shared stages; sph_stable_dt, sph_step, sph_advance
@@ -117,6 +118,19 @@ int main(void) {
    integration of the acoustic waves requires). sph_stable_dt combines the acoustic CFL
    (0.25 h / (c0 + |v|)), the viscous limit (0.125 h^2 / nu) and the force limit
    (0.25 sqrt(h / |a|)); sph_advance(&w, duration) steps with it, landing exactly on the end.
+
+   WCSPH, SECOND-ORDER SCHEME (def.scheme = SPH_SCHEME_SECOND_ORDER; periodic domains only)
+   Negi & Ramachandran 2022 (seed 002), L-IPST-C: the fluid density rho (w->rho) is carried by
+   continuity with the Bonet-Lok corrected divergence and gives p by the phase's EOS; the
+   operators integrate with the Shepard volume 1/sum_j W_ij of the geometry, never m/rho; the
+   pressure gradient is the corrected asymmetric form (1/rho_i) sum_j (p_j - p_i) B_i grad W_ij
+   omega_j and viscosity the coupled corrected Laplacian nu div(grad u); RK2 (midpoint);
+   iterative particle shifting every def.shift_every (10) steps with Taylor-corrected fields.
+   Use the quintic spline with h = 1.2 dx and dt = 0.3 h/(U + c0) (def.cfl = 0.3) as the paper
+   does; no walls, no delta-SPH or artificial viscosity. Velocity converges at second order on
+   Taylor-Green (tests/test_soc.c; bench/convergence.c: the study at c0 = 20, 40, 80, with run
+   times); the price is the correction matrices, two force stages per step and the shifting,
+   and momentum is conserved only to O(h^2). The operators are public (>>operators).
 
    SOLVER: PCISPH (sph_step_pcisph; sph_world_def_pcisph(&def, enhanced) sets it up)
    Predict-correct loop (Solenthaler & Pajarola 2009, seed 000): pressures are corrected from
@@ -389,6 +403,49 @@ SPHDEF sph_status sph_neighbors_build(sph_neighbors* nl, const sph_grid* g, cons
 SPHDEF void sph_neighbors_free(sph_neighbors* nl);
 
 /* ============================================================================================== */
+/* >>operators                                                                                    */
+/* ============================================================================================== */
+
+/* Corrected SPH derivative operators on any point set (Bonet & Lok 1999; Negi & Ramachandran
+   2022, seed 002 Table II), usable without a world. The points x (n of them, stride g->dim) are
+   those the grid was built on, and nl their lists from sph_neighbors_build(nl, g, x, x, n, k->radius,
+   exclude_self = 1); pair vectors follow the grid's periodic directions. vol[i] is the
+   integration volume omega_i [m^dim] (sph_op_volume), B the d x d correction matrix of each point
+   (d*d entries per point, row-major; sph_op_correction), or NULL for the uncorrected operator.
+   Scalar fields are read as f[i * stride]. On a lattice B = I and the corrected and uncorrected
+   operators agree; on disordered points only the corrected ones converge at second order
+   (tests/test_operators.c). Loops are parallel over points (OpenMP) and deterministic. */
+
+/* omega_i = 1 / (W(0) + sum_j W_ij) [m^dim]: the Shepard volume (seed 002 eq. 6). */
+SPHDEF void sph_op_volume(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
+                          const sph_real* x, size_t n, sph_real* vol);
+/* B_i = [sum_j omega_j grad W_ij (x) (x_j - x_i)]^-1 (seed 002 eq. 11, Bonet & Lok 1999): makes the
+   gradient exact for linear fields. Returns the number of points whose moment matrix was singular
+   (too few neighbours); theirs is set to the identity. */
+SPHDEF size_t sph_op_correction(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
+                                const sph_real* x, const sph_real* vol, size_t n, sph_real* B);
+/* grad f_i = sum_j (f_j - f_i) B_i grad W_ij omega_j  (asym_bc)   -> grad[i * dim + a] [f/m] */
+SPHDEF void sph_op_gradient(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
+                            const sph_real* x, const sph_real* vol, const sph_real* B,
+                            const sph_real* f, size_t stride, size_t n, sph_real* grad);
+/* div u_i = sum_j (u_j - u_i) . B_i grad W_ij omega_j  (div_bc), u with stride dim -> div[i] [u/m] */
+SPHDEF void sph_op_divergence(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
+                              const sph_real* x, const sph_real* vol, const sph_real* B,
+                              const sph_real* u, size_t n, sph_real* div);
+/* The iterative particle shifting displacement (Huang et al. 2019; seed 002 eq. 19):
+   dx_i = h sum_j n_ij W_ij omega_j, n_ij = (x_i - x_j)/|x_i - x_j|, which moves a point away from
+   crowded neighbours; repeated with fresh lists it relaxes a set to uniform spacing. [m] */
+SPHDEF void sph_op_shift(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
+                         const sph_real* x, const sph_real* vol, size_t n, sph_real* dx);
+/* Lap f_i = sum_j (G_j - G_i) . B_i grad W_ij omega_j, G = the corrected gradient of f
+   (coupled_bc: the divergence of the gradient, two passes). grad: scratch of n * dim reals that
+   holds G afterwards. -> lap[i] [f/m^2] */
+SPHDEF void sph_op_laplacian(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
+                             const sph_real* x, const sph_real* vol, const sph_real* B,
+                             const sph_real* f, size_t stride, size_t n, sph_real* grad,
+                             sph_real* lap);
+
+/* ============================================================================================== */
 /* >>world                                                                                        */
 /* ============================================================================================== */
 
@@ -431,6 +488,18 @@ typedef enum sph_integrator {
     SPH_INTEGRATOR_SYMPLECTIC_EULER = 0, /* kick-drift, one force evaluation (default)         */
     SPH_INTEGRATOR_VERLET                /* Stormer-Verlet drift-kick-drift, second order       */
 } sph_integrator;
+
+/* Which WCSPH scheme sph_step_wcsph runs. */
+typedef enum sph_wcsph_scheme {
+    SPH_SCHEME_STANDARD = 0, /* the options above: continuity/summation, delta-SPH, artificial and
+                                laminar viscosity, walls (default)                             */
+    SPH_SCHEME_SECOND_ORDER  /* seed 002's L-IPST-C (Negi & Ramachandran 2022): Bonet-Lok
+                                corrected pressure gradient and divergence, coupled Laplacian
+                                viscosity, fluid density apart from the Shepard volume, RK2
+                                midpoint, iterative shifting every def.shift_every steps with
+                                Taylor-corrected fields; every direction periodic, no walls.
+                                Second order in space (tests/test_soc.c, bench soc)      */
+} sph_wcsph_scheme;
 
 typedef enum sph_viscosity_form {
     SPH_VISC_MORRIS = 0, /* Morris et al. 1997: sum_j m_j (mu_i + mu_j) x_ij.grad W_ij /
@@ -527,6 +596,9 @@ typedef struct sph_world_def {
     sph_density density;       /* default SPH_DENSITY_CONTINUITY                                  */
     sph_pressure_grad pressure_grad; /* default SPH_PGRAD_SYMMETRIC                               */
     sph_integrator integrator; /* default SPH_INTEGRATOR_SYMPLECTIC_EULER                         */
+    sph_wcsph_scheme scheme;   /* default SPH_SCHEME_STANDARD                                     */
+    int shift_every;           /* SPH_SCHEME_SECOND_ORDER: shift every this many steps (seed 002:
+                                  10, the default); 0 = never                                    */
     sph_pressure_clamp clamp;  /* default SPH_CLAMP_AUTO: summation density sees a deficit at a
                                   free surface, so its negative pressures would pull the surface
                                   into the fluid (Becker & Teschner 2007 clamp them)             */
@@ -622,6 +694,17 @@ typedef struct sph__private {
     size_t xp_cap, vp_cap;
     sph_real *de, *cs, *vn;         /* compressible: energy rate, sound speed, v at the step start  */
     size_t de_cap, cs_cap, vn_cap;
+    sph_real* soc;                  /* second-order scheme: its per-particle scratch                */
+    size_t soc_cap;
+    sph_real* socw;                 /* second-order scheme: omega_j B_i grad W_ij per listed pair   */
+    size_t socw_cap;
+    sph_grid sgrid;                 /* second-order scheme: grid and lists at stage and shifted
+                                       positions (the particles are not reordered mid-step)      */
+    sph_neighbors snl;
+    int sgrid_ready;
+    int snl_valid;                  /* snl lists the current particle order (cleared by sorts)      */
+    uint64_t sorts;                 /* fluid reorderings so far; snl_sorts: at the lists' build    */
+    uint64_t snl_sorts;
     sph_real* bpq;                  /* multiphase walls: (p_b, rho_b/rho0) per wall particle and
                                        phase, extrapolated from that phase's particles (scratch)   */
     size_t bpq_cap;
@@ -1537,6 +1620,196 @@ SPHDEF void sph_neighbors_free(sph_neighbors* nl) {
 }
 
 /* ============================================================================================== */
+/* >>operators (implementation)                                                                   */
+/* ============================================================================================== */
+
+SPHDEF void sph_op_volume(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
+                          const sph_real* x, size_t n, sph_real* vol) {
+    const size_t D = (size_t)g->dim;
+    const sph_real w0 = sph_kernel_w(k, 0);
+    sph__idx i;
+    SPH__OMP_FOR(n)
+    for (i = 0; i < (sph__idx)n; ++i) {
+        const size_t k0 = nl->begin[i], k1 = k0 + nl->count[i];
+        sph_real sum = w0, d[3], r2;
+        size_t kk, a;
+        for (kk = k0; kk < k1; ++kk) {
+            sph_grid_delta(g, x + (size_t)i * D, x + (size_t)nl->idx[kk] * D, d);
+            for (r2 = 0, a = 0; a < D; ++a) r2 += d[a] * d[a];
+            sum += sph_kernel_w(k, sph__sqrt(r2));
+        }
+        vol[i] = 1 / sum;
+    }
+}
+
+/* Inverts the d x d matrix A in place; returns 0 if it is singular relative to its size. */
+static int sph__invert(sph_real* A, int d) {
+    if (d == 1) {
+        if (!(sph__fabs(A[0]) > SPH__R(1e-12))) return 0;
+        A[0] = 1 / A[0];
+        return 1;
+    }
+    if (d == 2) {
+        const sph_real det = A[0] * A[3] - A[1] * A[2];
+        const sph_real scale = sph__fabs(A[0] * A[3]) + sph__fabs(A[1] * A[2]);
+        sph_real t;
+        if (!(sph__fabs(det) > SPH__R(1e-9) * scale)) return 0;
+        t = A[0];
+        A[0] = A[3] / det;
+        A[3] = t / det;
+        A[1] = -A[1] / det;
+        A[2] = -A[2] / det;
+        return 1;
+    } else {
+        sph_real c[9], det, scale = 0;
+        int q;
+        c[0] = A[4] * A[8] - A[5] * A[7];
+        c[1] = A[2] * A[7] - A[1] * A[8];
+        c[2] = A[1] * A[5] - A[2] * A[4];
+        c[3] = A[5] * A[6] - A[3] * A[8];
+        c[4] = A[0] * A[8] - A[2] * A[6];
+        c[5] = A[2] * A[3] - A[0] * A[5];
+        c[6] = A[3] * A[7] - A[4] * A[6];
+        c[7] = A[1] * A[6] - A[0] * A[7];
+        c[8] = A[0] * A[4] - A[1] * A[3];
+        det = A[0] * c[0] + A[1] * c[3] + A[2] * c[6];
+        for (q = 0; q < 9; ++q) scale += sph__fabs(A[q]);
+        if (!(sph__fabs(det) > SPH__R(1e-9) * scale * scale * scale)) return 0;
+        for (q = 0; q < 9; ++q) A[q] = c[q] / det;
+        return 1;
+    }
+}
+
+SPHDEF size_t sph_op_correction(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
+                                const sph_real* x, const sph_real* vol, size_t n, sph_real* B) {
+    const int D = g->dim;
+    const size_t DD = (size_t)(D * D);
+    size_t singular = 0;
+    sph__idx i;
+#if defined(_OPENMP)
+#pragma omp parallel for schedule(static) reduction(+ : singular) if (n > 2048)
+#endif
+    for (i = 0; i < (sph__idx)n; ++i) {
+        const size_t k0 = nl->begin[i], k1 = k0 + nl->count[i];
+        sph_real* Bi = B + (size_t)i * DD;
+        sph_real d[3], gw[3];
+        size_t kk;
+        int a, b;
+        for (a = 0; a < (int)DD; ++a) Bi[a] = 0;
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t j = nl->idx[kk];
+            sph_grid_delta(g, x + (size_t)i * (size_t)D, x + j * (size_t)D, d); /* x_i - x_j */
+            sph_kernel_grad(k, d, gw);
+            for (a = 0; a < D; ++a) /* A^{ab} = sum_j omega_j d_a W_ij (x_j - x_i)^b */
+                for (b = 0; b < D; ++b) Bi[a * D + b] -= vol[j] * gw[a] * d[b];
+        }
+        if (!sph__invert(Bi, D)) {
+            for (a = 0; a < (int)DD; ++a) Bi[a] = 0;
+            for (a = 0; a < D; ++a) Bi[a * D + a] = 1;
+            ++singular;
+        }
+    }
+    return singular;
+}
+
+/* grad W_ij of the pair, corrected by B_i when B is given. */
+SPH__INLINE void sph__op_gradw(const sph_grid* g, const sph_kernel* k, const sph_real* B,
+                               const sph_real* xi, const sph_real* xj, size_t i, sph_real* gw) {
+    const int D = g->dim;
+    sph_real d[3], t[3];
+    int a, b;
+    sph_grid_delta(g, xi, xj, d);
+    sph_kernel_grad(k, d, t);
+    if (!B) {
+        for (a = 0; a < D; ++a) gw[a] = t[a];
+        return;
+    }
+    for (a = 0; a < D; ++a) {
+        const sph_real* row = B + i * (size_t)(D * D) + (size_t)(a * D);
+        gw[a] = 0;
+        for (b = 0; b < D; ++b) gw[a] += row[b] * t[b];
+    }
+}
+
+SPHDEF void sph_op_gradient(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
+                            const sph_real* x, const sph_real* vol, const sph_real* B,
+                            const sph_real* f, size_t stride, size_t n, sph_real* grad) {
+    const int D = g->dim;
+    sph__idx i;
+    SPH__OMP_FOR(n)
+    for (i = 0; i < (sph__idx)n; ++i) {
+        const size_t k0 = nl->begin[i], k1 = k0 + nl->count[i];
+        const sph_real fi = f[(size_t)i * stride];
+        sph_real acc[3] = {0, 0, 0}, gw[3];
+        size_t kk;
+        int a;
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t j = nl->idx[kk];
+            const sph_real df = (f[j * stride] - fi) * vol[j];
+            sph__op_gradw(g, k, B, x + (size_t)i * (size_t)D, x + j * (size_t)D, (size_t)i, gw);
+            for (a = 0; a < D; ++a) acc[a] += df * gw[a];
+        }
+        for (a = 0; a < D; ++a) grad[(size_t)i * (size_t)D + (size_t)a] = acc[a];
+    }
+}
+
+SPHDEF void sph_op_divergence(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
+                              const sph_real* x, const sph_real* vol, const sph_real* B,
+                              const sph_real* u, size_t n, sph_real* div) {
+    const int D = g->dim;
+    sph__idx i;
+    SPH__OMP_FOR(n)
+    for (i = 0; i < (sph__idx)n; ++i) {
+        const size_t k0 = nl->begin[i], k1 = k0 + nl->count[i];
+        const sph_real* ui = u + (size_t)i * (size_t)D;
+        sph_real acc = 0, gw[3];
+        size_t kk;
+        int a;
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t j = nl->idx[kk];
+            const sph_real* uj = u + j * (size_t)D;
+            sph_real dot = 0;
+            sph__op_gradw(g, k, B, x + (size_t)i * (size_t)D, x + j * (size_t)D, (size_t)i, gw);
+            for (a = 0; a < D; ++a) dot += (uj[a] - ui[a]) * gw[a];
+            acc += dot * vol[j];
+        }
+        div[i] = acc;
+    }
+}
+
+SPHDEF void sph_op_shift(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
+                         const sph_real* x, const sph_real* vol, size_t n, sph_real* dx) {
+    const int D = g->dim;
+    sph__idx i;
+    SPH__OMP_FOR(n)
+    for (i = 0; i < (sph__idx)n; ++i) {
+        const size_t k0 = nl->begin[i], k1 = k0 + nl->count[i];
+        sph_real acc[3] = {0, 0, 0}, d[3];
+        size_t kk;
+        int a;
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t j = nl->idx[kk];
+            sph_real r2 = 0, r, c;
+            sph_grid_delta(g, x + (size_t)i * (size_t)D, x + j * (size_t)D, d);
+            for (a = 0; a < D; ++a) r2 += d[a] * d[a];
+            r = sph__sqrt(r2);
+            if (!(r > 0)) continue;
+            c = sph_kernel_w(k, r) * vol[j] / r;
+            for (a = 0; a < D; ++a) acc[a] += c * d[a];
+        }
+        for (a = 0; a < D; ++a) dx[(size_t)i * (size_t)D + (size_t)a] = k->h * acc[a];
+    }
+}
+
+SPHDEF void sph_op_laplacian(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
+                             const sph_real* x, const sph_real* vol, const sph_real* B,
+                             const sph_real* f, size_t stride, size_t n, sph_real* grad,
+                             sph_real* lap) {
+    sph_op_gradient(g, nl, k, x, vol, B, f, stride, n, grad);
+    sph_op_divergence(g, nl, k, x, vol, B, grad, n, lap);
+}
+
+/* ============================================================================================== */
 /* >>world (implementation)                                                                       */
 /* ============================================================================================== */
 
@@ -1552,6 +1825,8 @@ SPHDEF sph_world_def sph_world_def_default(int dim) {
     d.density = SPH_DENSITY_CONTINUITY;
     d.pressure_grad = SPH_PGRAD_SYMMETRIC;
     d.integrator = SPH_INTEGRATOR_SYMPLECTIC_EULER;
+    d.scheme = SPH_SCHEME_STANDARD;
+    d.shift_every = 10;
     d.delta = SPH__R(0.1);  /* Molteni & Colagrossi 2009; seed 000 sec. 3.2.1: "usually 0.1" */
     d.alpha = SPH__R(0.02);
     d.beta = 0;
@@ -1668,6 +1943,9 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
                "sph_world_def.pressure_grad = %d: not a sph_pressure_grad", (int)d->pressure_grad);
     SPH__CHECK((int)d->integrator >= 0 && d->integrator <= SPH_INTEGRATOR_VERLET,
                "sph_world_def.integrator = %d: not a sph_integrator", (int)d->integrator);
+    SPH__CHECK((int)d->scheme >= 0 && d->scheme <= SPH_SCHEME_SECOND_ORDER,
+               "sph_world_def.scheme = %d: not a sph_wcsph_scheme", (int)d->scheme);
+    SPH__CHECK(d->shift_every >= 0, "sph_world_def.shift_every = %d: must be >= 0", d->shift_every);
     SPH__CHECK((int)d->clamp >= 0 && d->clamp <= SPH_CLAMP_OFF,
                "sph_world_def.clamp = %d: not a sph_pressure_clamp", (int)d->clamp);
     SPH__CHECK((int)d->viscosity_form >= 0 && d->viscosity_form <= SPH_VISC_MONAGHAN,
@@ -1796,6 +2074,10 @@ SPHDEF void sph_world_free(sph_world* w) {
     SPH_FREE(w->priv.cs);
     SPH_FREE(w->priv.vn);
     SPH_FREE(w->priv.bpq);
+    SPH_FREE(w->priv.soc);
+    SPH_FREE(w->priv.socw);
+    sph_grid_free(&w->priv.sgrid);
+    sph_neighbors_free(&w->priv.snl);
     memset(w, 0, sizeof(*w));
     w->error_index = -1;
 }
@@ -2276,13 +2558,15 @@ SPHDEF size_t sph_world_memory(const sph_world* w) {
     for (k = 0; k < n; ++k) bytes += w->capacity * arr[k].elem;
     n = sph__boundary_arrays((sph_world*)w, arr);
     for (k = 0; k < n; ++k) bytes += w->b_capacity * arr[k].elem;
-    bytes += sph__grid_memory(&w->priv.grid) + sph__grid_memory(&w->priv.bgrid);
+    bytes += sph__grid_memory(&w->priv.grid) + sph__grid_memory(&w->priv.bgrid) +
+             sph__grid_memory(&w->priv.sgrid);
     bytes += sph__neighbors_memory(&w->priv.ff) + sph__neighbors_memory(&w->priv.fb) +
-             sph__neighbors_memory(&w->priv.bf) + sph__neighbors_memory(&w->priv.bb);
+             sph__neighbors_memory(&w->priv.bf) + sph__neighbors_memory(&w->priv.bb) +
+             sph__neighbors_memory(&w->priv.snl);
     bytes += w->priv.perm_cap + w->priv.block_cap * sizeof(double) +
              (w->priv.rho_n_cap + w->priv.aii_cap + w->priv.src_cap + w->priv.ap_cap +
               w->priv.ff_fw_cap + w->priv.fb_fw_cap + w->priv.pr2_cap + w->priv.xp_cap +
-              w->priv.vp_cap + w->priv.de_cap + w->priv.cs_cap + w->priv.vn_cap + w->priv.bpq_cap) *
+              w->priv.vp_cap + w->priv.de_cap + w->priv.cs_cap + w->priv.vn_cap + w->priv.bpq_cap + w->priv.soc_cap + w->priv.socw_cap) *
                  sizeof(sph_real);
     return bytes;
 }
@@ -2722,6 +3006,8 @@ static sph_status sph__scratch(sph_world* w, sph_real** p, size_t count) {
                   : p == &w->priv.cs    ? &w->priv.cs_cap
                   : p == &w->priv.vn    ? &w->priv.vn_cap
                   : p == &w->priv.bpq   ? &w->priv.bpq_cap
+                  : p == &w->priv.soc   ? &w->priv.soc_cap
+                  : p == &w->priv.socw  ? &w->priv.socw_cap
                                         : NULL;
     SPH_ASSERT(cap);
     if (count <= *cap && *p) return SPH_OK;
@@ -2815,6 +3101,7 @@ static sph_status sph__stage_neighbors(sph_world* w) {
     if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour grid: %s", sph_status_string(s));
     narr = sph__fluid_arrays(w, arr);
     sph__permute(w, arr, narr, w->priv.grid.order, w->n);
+    ++w->priv.sorts;
     if (w->nb > 0 && (w->priv.b_dirty || w->def.boundary_motion)) {
         s = sph_grid_build(&w->priv.bgrid, w->b_x, w->nb);
         if (s != SPH_OK) return sph__fail(w, s, -1, "boundary grid: %s", sph_status_string(s));
@@ -3530,6 +3817,410 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
 }
 
 /* Adds the step's timings to the world's totals. */
+
+/* ---- the second-order scheme (seed 002, L-IPST-C) ---------------------------------------------
+   Negi & Ramachandran 2022 (seed 002 sec. II D 1, digest sec. 5.2), for periodic domains:
+       d rho_i/dt = -rho_i <div u>_i                         div_bc (Table II)
+       d u_i/dt   = -<grad p>_i / rho_i + nu <Lap u>_i + g    asym_bc, coupled_bc
+   with rho the fluid density carried by the particle (w->rho) and p = p(rho) by the phase's
+   equation of state; the operators' volumes are the Shepard volumes omega = 1/sum_j W_ij of the
+   geometry, never m/rho (sec. III A: the EOS must not see the particle density). Decisions where
+   the paper is silent (digest sec. 10): RK2 is the midpoint rule (y* = y + dt/2 f(y), then
+   y += dt f(y*)), the midpoint with its own neighbour lists; shifting (eq. 19-21) runs after
+   every def.shift_every-th step, at most 10 iterations, until max_i |chi_i - chi_0| < 1e-3 chi_0
+   with chi = h^d sum_j W_ij (chi_0 its lattice value; the paper leaves epsilon open), and each
+   iteration Taylor-corrects u and rho with their corrected gradients at the positions before
+   it moved (eq. 22; p follows from rho). No delta-SPH term, no artificial viscosity: the
+   scheme is what converges. The corrected operators do not conserve momentum exactly; the
+   drift is O(h^2) and reported by the tests. */
+static sph_status sph__soc_check(sph_world* w) {
+    int k;
+    for (k = 0; k < w->dim; ++k)
+        if (!w->def.periodic[k])
+            return sph__fail(w, SPH_ERR_ARG, -1,
+                             "def.scheme = SPH_SCHEME_SECOND_ORDER needs every direction periodic "
+                             "(direction %d is not): seed 002 has no second-order wall condition", k);
+    if (w->nb > 0)
+        return sph__fail(w, SPH_ERR_ARG, -1,
+                         "def.scheme = SPH_SCHEME_SECOND_ORDER runs without walls (%zu boundary "
+                         "particles)", w->nb);
+    if (w->def.density == SPH_DENSITY_SUMMATION)
+        return sph__fail(w, SPH_ERR_ARG, -1,
+                         "def.scheme = SPH_SCHEME_SECOND_ORDER carries the fluid density by "
+                         "continuity: def.density must not be SPH_DENSITY_SUMMATION");
+    return SPH_OK;
+}
+
+/* Scratch layout (n particles, D dims): vol n, B n D^2, gp n D, tmp n D, lap n, x0 n D, v0 n D,
+   r0 n, dxs n D, xref n D (the positions the lists were built at). */
+typedef struct sph__soc {
+    sph_real *vol, *B, *gp, *tmp, *lap, *x0, *v0, *r0, *dxs, *xref;
+} sph__soc;
+
+/* The lists carry a skin of 0.2 dx beyond the support and hold while no particle has moved
+   half of it since they were built: one build serves both RK2 stages and the shifting
+   iterations, and usually several steps (pairs beyond the support add zero). */
+#define SPH__SOC_SKIN SPH__R(0.2)
+
+static sph_status sph__soc_scratch(sph_world* w, sph__soc* S) {
+    const size_t n = w->capacity, D = (size_t)w->dim;
+    sph_status s = sph__scratch(w, &w->priv.soc, n * (3 + 6 * D + D * D));
+    sph_real* q = w->priv.soc;
+    if (s != SPH_OK) return s;
+    S->vol = q; q += n;
+    S->B = q; q += n * D * D;
+    S->gp = q; q += n * D;
+    S->tmp = q; q += n * D;
+    S->lap = q; q += n;
+    S->x0 = q; q += n * D;
+    S->v0 = q; q += n * D;
+    S->r0 = q; q += n;
+    S->dxs = q; q += n * D;
+    S->xref = q;
+    if (!w->priv.sgrid_ready) {
+        s = sph_grid_init(&w->priv.sgrid, w->dim, w->kernel.radius + SPH__SOC_SKIN * w->dx,
+                          w->priv.grid.periodic, w->def.domain_lo, w->def.domain_hi);
+        if (s != SPH_OK) return sph__fail(w, s, -1, "second-order scheme: grid setup failed");
+        w->priv.sgrid_ready = 1;
+    }
+    return SPH_OK;
+}
+
+/* Makes w->priv.snl valid for the current positions: kept if no particle moved half the skin
+   since its build (and nothing reordered or added particles), else rebuilt, after sorting the
+   particles by cell when `sort` (only between steps: the stage copies are not reordered). */
+static sph_status sph__soc_lists(sph_world* w, const sph__soc* S, int sort) {
+    const size_t n = w->n, D = (size_t)w->dim;
+    const sph_real half = SPH__R(0.5) * SPH__SOC_SKIN * w->dx;
+    sph_status s;
+    if (w->priv.snl_valid && w->priv.snl_sorts == w->priv.sorts && w->priv.snl.n == n) {
+        sph_real m2 = 0;
+        size_t i;
+        for (i = 0; i < n; ++i) {
+            sph_real d[3], r2 = 0;
+            size_t a;
+            sph_grid_delta(&w->priv.sgrid, w->x + i * D, S->xref + i * D, d);
+            for (a = 0; a < D; ++a) r2 += d[a] * d[a];
+            if (r2 > m2) m2 = r2;
+        }
+        if (m2 < half * half) return SPH_OK;
+    }
+    if (sort) {
+        sph__array arr[16];
+        int narr;
+        s = sph_grid_build(&w->priv.grid, w->x, n);
+        if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour grid: %s", sph_status_string(s));
+        narr = sph__fluid_arrays(w, arr);
+        sph__permute(w, arr, narr, w->priv.grid.order, n);
+        ++w->priv.sorts;
+    }
+    s = sph_grid_build(&w->priv.sgrid, w->x, n);
+    if (s == SPH_OK)
+        s = sph_neighbors_build(&w->priv.snl, &w->priv.sgrid, w->x, w->x, n,
+                                w->kernel.radius + SPH__SOC_SKIN * w->dx, 1);
+    if (s != SPH_OK) return sph__fail(w, s, -1, "second-order scheme: neighbour lists: %s",
+                                      sph_status_string(s));
+    memcpy(S->xref, w->x, n * D * sizeof(sph_real));
+    w->priv.snl_valid = 1;
+    w->priv.snl_sorts = w->priv.sorts;
+    w->stats.pairs = w->priv.snl.total;
+    return SPH_OK;
+}
+
+/* d = a - b with the periodic minimum image (the scheme's domain is periodic). */
+SPH__INLINE void sph__soc_delta(const sph_grid* g, const sph_real* a, const sph_real* b,
+                                sph_real* d, int D) {
+    int k;
+    for (k = 0; k < D; ++k) d[k] = sph__wrap_delta(a[k] - b[k], g->len[k]);
+}
+
+/* The geometry of a neighbourhood, once per stage: the Shepard volumes omega_i and, with
+   `gradients`, the corrected kernel gradient of every listed pair weighted by the neighbour's
+   volume, gw[kk] = omega_j B_i grad W_ij, so that each operator after it is a few multiply-adds
+   per pair (the public sph_op_* recompute the kernel in every call). */
+static sph_status sph__soc_geometry(sph_world* w, const sph_grid* g, const sph_neighbors* nl,
+                                    const sph__soc* S, int gradients) {
+    const size_t n = w->n, D = (size_t)w->dim;
+    const int Di = w->dim;
+    const sph_kernel* k = &w->kernel;
+    sph_real* gw;
+    sph__idx i;
+    if (!gradients) {
+        sph_op_volume(g, nl, k, w->x, n, S->vol);
+        return SPH_OK;
+    }
+    /* indexed like nl->idx, whose chunks leave gaps: sized by its capacity */
+    if (sph__scratch(w, &w->priv.socw, nl->cap_idx * D + D) != SPH_OK) return w->status;
+    gw = w->priv.socw;
+    SPH__OMP_FOR(n)
+    for (i = 0; i < (sph__idx)n; ++i) { /* W sums and raw gradients */
+        const size_t k0 = nl->begin[i], k1 = k0 + nl->count[i];
+        sph_real sum = k->norm_w * sph__kw(k->form, 0), d[3], r2, q, f;
+        size_t kk, a;
+        for (kk = k0; kk < k1; ++kk) {
+            sph__soc_delta(g, w->x + (size_t)i * D, w->x + (size_t)nl->idx[kk] * D, d, Di);
+            for (r2 = 0, a = 0; a < D; ++a) r2 += d[a] * d[a];
+            q = sph__sqrt(r2) * k->inv_h; /* the skin's pairs beyond the support add zero */
+            sum += k->norm_w * sph__kw(k->form, q);
+            f = k->norm_g * sph__kf(k->form, q);
+            for (a = 0; a < D; ++a) gw[kk * D + a] = f * d[a];
+        }
+        S->vol[i] = 1 / sum;
+    }
+    SPH__OMP_FOR(n)
+    for (i = 0; i < (sph__idx)n; ++i) { /* B_i, then gw = omega_j B_i grad W_ij */
+        const size_t k0 = nl->begin[i], k1 = k0 + nl->count[i];
+        sph_real* Bi = S->B + (size_t)i * D * D;
+        sph_real d[3], t[3];
+        size_t kk;
+        int a, b;
+        for (a = 0; a < Di * Di; ++a) Bi[a] = 0;
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t j = nl->idx[kk];
+            sph__soc_delta(g, w->x + (size_t)i * D, w->x + j * D, d, Di); /* x_i - x_j */
+            for (a = 0; a < Di; ++a)
+                for (b = 0; b < Di; ++b) Bi[a * Di + b] -= S->vol[j] * gw[kk * D + (size_t)a] * d[b];
+        }
+        if (!sph__invert(Bi, Di)) { /* too few neighbours: uncorrected */
+            for (a = 0; a < Di * Di; ++a) Bi[a] = 0;
+            for (a = 0; a < Di; ++a) Bi[a * Di + a] = 1;
+        }
+        for (kk = k0; kk < k1; ++kk) {
+            const sph_real vj = S->vol[nl->idx[kk]];
+            for (a = 0; a < Di; ++a) t[a] = gw[kk * D + (size_t)a];
+            for (a = 0; a < Di; ++a) {
+                sph_real acc = 0;
+                for (b = 0; b < Di; ++b) acc += Bi[a * Di + b] * t[b];
+                gw[kk * D + (size_t)a] = vj * acc;
+            }
+        }
+    }
+    return SPH_OK;
+}
+
+/* grad f_i = sum_j (f_j - f_i) gw_ij (asym_bc), f read with a stride. */
+static void sph__soc_grad(const sph_world* w, const sph_neighbors* nl, const sph_real* f,
+                          size_t stride, sph_real* grad) {
+    const size_t D = (size_t)w->dim;
+    const sph_real* gw = w->priv.socw;
+    sph__idx i;
+    SPH__OMP_FOR(w->n)
+    for (i = 0; i < (sph__idx)w->n; ++i) {
+        const size_t k0 = nl->begin[i], k1 = k0 + nl->count[i];
+        const sph_real fi = f[(size_t)i * stride];
+        sph_real acc[3] = {0, 0, 0};
+        size_t kk, a;
+        for (kk = k0; kk < k1; ++kk) {
+            const sph_real df = f[(size_t)nl->idx[kk] * stride] - fi;
+            for (a = 0; a < D; ++a) acc[a] += df * gw[kk * D + a];
+        }
+        for (a = 0; a < D; ++a) grad[(size_t)i * D + a] = acc[a];
+    }
+}
+
+/* div u_i = sum_j (u_j - u_i) . gw_ij (div_bc), u with stride D. */
+static void sph__soc_div(const sph_world* w, const sph_neighbors* nl, const sph_real* u, sph_real* div) {
+    const size_t D = (size_t)w->dim;
+    const sph_real* gw = w->priv.socw;
+    sph__idx i;
+    SPH__OMP_FOR(w->n)
+    for (i = 0; i < (sph__idx)w->n; ++i) {
+        const size_t k0 = nl->begin[i], k1 = k0 + nl->count[i];
+        const sph_real* ui = u + (size_t)i * D;
+        sph_real acc = 0;
+        size_t kk, a;
+        for (kk = k0; kk < k1; ++kk) {
+            const sph_real* uj = u + (size_t)nl->idx[kk] * D;
+            for (a = 0; a < D; ++a) acc += (uj[a] - ui[a]) * gw[kk * D + a];
+        }
+        div[i] = acc;
+    }
+}
+
+/* The right-hand sides at the world's current x, v, rho with lists (g, nl): w->a, w->drho. */
+static sph_status sph__soc_rhs(sph_world* w, const sph__ctx* c, const sph__soc* S,
+                               const sph_grid* g, const sph_neighbors* nl) {
+    const size_t n = w->n, D = (size_t)w->dim;
+    sph__idx i;
+    size_t a;
+    int any_visc = 0, q;
+    if (sph__soc_geometry(w, g, nl, S, 1) != SPH_OK) return w->status;
+    SPH__OMP_FOR(n)
+    for (i = 0; i < (sph__idx)n; ++i) w->p[i] = sph__eos(&c->pc[w->phase[i]], w->rho[i]);
+    sph__soc_grad(w, nl, w->p, 1, S->gp);
+    sph__soc_div(w, nl, w->v, S->lap);
+    sph__stage_body_force(w, c); /* w->a = g + the user's forces */
+    SPH__OMP_FOR(n)
+    for (i = 0; i < (sph__idx)n; ++i) {
+        const sph_real inv = 1 / w->rho[i];
+        size_t b;
+        w->drho[i] = -w->rho[i] * S->lap[i];
+        for (b = 0; b < D; ++b) w->a[(size_t)i * D + b] -= S->gp[(size_t)i * D + b] * inv;
+    }
+    for (q = 0; q < w->nphase; ++q) if (w->phases[q].viscosity > 0) any_visc = 1;
+    if (!any_visc) return SPH_OK;
+    for (a = 0; a < D; ++a) { /* nu <Lap u_a>_i = div of the corrected gradient (coupled_bc) */
+        sph__soc_grad(w, nl, w->v + a, D, S->tmp);
+        sph__soc_div(w, nl, S->tmp, S->lap);
+        SPH__OMP_FOR(n)
+        for (i = 0; i < (sph__idx)n; ++i)
+            w->a[(size_t)i * D + a] += w->phases[w->phase[i]].viscosity * S->lap[i];
+    }
+    return SPH_OK;
+}
+
+static void sph__soc_wrap(sph_world* w, const sph__ctx* c, sph_real* x) {
+    const int D = w->dim;
+    sph__idx i;
+    SPH__OMP_FOR(w->n)
+    for (i = 0; i < (sph__idx)w->n; ++i) {
+        int kk;
+        for (kk = 0; kk < D; ++kk) {
+            sph_real* xi = x + (size_t)i * (size_t)D + (size_t)kk;
+            const sph_real lo = w->def.domain_lo[kk];
+            if (*xi < lo || *xi >= lo + c->len[kk]) *xi -= c->len[kk] * sph__floor((*xi - lo) / c->len[kk]);
+            if (*xi >= lo + c->len[kk]) *xi = lo;
+        }
+    }
+}
+
+/* Iterative particle shifting with Taylor-corrected velocity and density (eq. 19-22). Returns
+   the iterations that moved particles in w->stats.iterations. */
+static sph_status sph__soc_shift(sph_world* w, const sph__ctx* c, const sph__soc* S) {
+    const size_t n = w->n, D = (size_t)w->dim;
+    const sph_kernel* k = &w->kernel;
+    const sph_grid* g = &w->priv.sgrid;
+    const sph_neighbors* nl = &w->priv.snl;
+    double chi0 = (double)w->priv.lattice_sum, hd = 1;
+    int it, dd;
+    for (dd = 0; dd < w->dim; ++dd) {
+        chi0 *= (double)(k->h / w->dx); /* h^d sum W on the lattice */
+        hd *= (double)k->h;
+    }
+    for (it = 0; it < 10; ++it) {
+        double dev = 0;
+        sph__idx i;
+        sph_status s = sph__soc_lists(w, S, 0);
+        size_t a;
+        if (s != SPH_OK) return s;
+        s = sph__soc_geometry(w, g, nl, S, 1);
+        if (s != SPH_OK) return s;
+        for (i = 0; i < (sph__idx)n; ++i) { /* chi_i = h^d / omega_i */
+            const double dv = fabs(hd / (double)S->vol[i] - chi0);
+            if (dv > dev) dev = dv;
+        }
+        if (dev < 1e-3 * chi0) break;
+        SPH__OMP_FOR(n)
+        for (i = 0; i < (sph__idx)n; ++i) { /* eq. 19: dx_i = h sum_j n_ij W_ij omega_j */
+            const size_t k0 = nl->begin[i], k1 = k0 + nl->count[i];
+            sph_real acc[3] = {0, 0, 0}, d[3];
+            size_t kk, b;
+            for (kk = k0; kk < k1; ++kk) {
+                const size_t j = nl->idx[kk];
+                sph_real r2 = 0, r, cw;
+                sph__soc_delta(g, w->x + (size_t)i * D, w->x + j * D, d, w->dim);
+                for (b = 0; b < D; ++b) r2 += d[b] * d[b];
+                r = sph__sqrt(r2);
+                if (!(r > 0)) continue;
+                cw = k->norm_w * sph__kw(k->form, r * k->inv_h) * S->vol[j] / r;
+                for (b = 0; b < D; ++b) acc[b] += cw * d[b];
+            }
+            for (b = 0; b < D; ++b) S->dxs[(size_t)i * D + b] = k->h * acc[b];
+        }
+        /* Taylor correction, gradients at the positions before the move */
+        sph__soc_grad(w, nl, w->rho, 1, S->gp);
+        SPH__OMP_FOR(n)
+        for (i = 0; i < (sph__idx)n; ++i) {
+            sph_real dr = 0;
+            size_t b;
+            for (b = 0; b < D; ++b) dr += S->dxs[(size_t)i * D + b] * S->gp[(size_t)i * D + b];
+            S->r0[i] = w->rho[i] + dr;
+        }
+        for (a = 0; a < D; ++a) {
+            sph__soc_grad(w, nl, w->v + a, D, S->tmp);
+            SPH__OMP_FOR(n)
+            for (i = 0; i < (sph__idx)n; ++i) {
+                sph_real dv = 0;
+                size_t b;
+                for (b = 0; b < D; ++b) dv += S->dxs[(size_t)i * D + b] * S->tmp[(size_t)i * D + b];
+                S->v0[(size_t)i * D + a] = w->v[(size_t)i * D + a] + dv;
+            }
+        }
+        SPH__OMP_FOR(n)
+        for (i = 0; i < (sph__idx)n; ++i) {
+            size_t b;
+            w->rho[i] = S->r0[i];
+            for (b = 0; b < D; ++b) {
+                w->v[(size_t)i * D + b] = S->v0[(size_t)i * D + b];
+                w->x[(size_t)i * D + b] += S->dxs[(size_t)i * D + b];
+            }
+        }
+        sph__soc_wrap(w, c, w->x);
+    }
+    w->stats.iterations = it;
+    return SPH_OK;
+}
+
+/* From the step's start state: x = x0 + k u, v = v0 + k a, rho = r0 + k drho, with u = v0 (first
+   stage) or the midpoint velocity in w->v (read before it is overwritten). */
+static void sph__soc_update(sph_world* w, const sph__ctx* c, const sph__soc* S, sph_real k,
+                            const sph_real* u) {
+    const size_t D = (size_t)w->dim;
+    sph__idx i;
+    SPH__OMP_FOR(w->n)
+    for (i = 0; i < (sph__idx)w->n; ++i) {
+        const size_t o = (size_t)i * D;
+        size_t b;
+        for (b = 0; b < D; ++b) {
+            w->x[o + b] = S->x0[o + b] + k * u[o + b];
+            w->v[o + b] = S->v0[o + b] + k * w->a[o + b];
+        }
+        w->rho[i] = S->r0[i] + k * w->drho[i];
+    }
+    sph__soc_wrap(w, c, w->x);
+}
+
+static sph_status sph__step_soc(sph_world* w, sph_real dt) {
+    const size_t n = w->n, D = (size_t)w->dim;
+    const sph_real h2 = SPH__R(0.5) * dt;
+    double t0 = sph__now(), tstart = t0;
+    sph__ctx c;
+    sph__soc S;
+    sph_status s = sph__soc_scratch(w, &S);
+    if (s != SPH_OK) return s;
+    s = sph__soc_lists(w, &S, 1); /* sorts the particles by cell when the lists are rebuilt */
+    if (s != SPH_OK) return s;
+    sph__ctx_init(w, &c);
+    sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
+    memcpy(S.x0, w->x, n * D * sizeof(sph_real));
+    memcpy(S.v0, w->v, n * D * sizeof(sph_real));
+    memcpy(S.r0, w->rho, n * sizeof(sph_real));
+    /* stage 1 at t^n */
+    s = sph__soc_rhs(w, &c, &S, &w->priv.sgrid, &w->priv.snl);
+    if (s != SPH_OK) return s;
+    sph__time(w, SPH_STAGE_FORCES, &t0);
+    sph__soc_update(w, &c, &S, h2, S.v0);
+    /* stage 2 at the midpoint */
+    s = sph__soc_lists(w, &S, 0);
+    if (s != SPH_OK) return s;
+    sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
+    s = sph__soc_rhs(w, &c, &S, &w->priv.sgrid, &w->priv.snl);
+    if (s != SPH_OK) return s;
+    sph__time(w, SPH_STAGE_FORCES, &t0);
+    sph__soc_update(w, &c, &S, dt, w->v);
+    ++w->steps;
+    w->time += (double)dt;
+    sph__time(w, SPH_STAGE_INTEGRATE, &t0);
+    if (w->def.shift_every > 0 && w->steps % (uint64_t)w->def.shift_every == 0) {
+        s = sph__soc_shift(w, &c, &S);
+        if (s != SPH_OK) return s;
+        sph__time(w, SPH_STAGE_INTEGRATE, &t0);
+    }
+    s = sph__integrate_with(w, &c, w->a, 0, 0, 0, 1); /* diagnostics and blow-up checks only */
+    w->stats.step_time = sph__now() - tstart;
+    return s;
+}
+
 static sph_status sph__step_end(sph_world* w, sph_status s) {
     int k;
     w->step_time_total += w->stats.step_time;
@@ -3540,6 +4231,11 @@ static sph_status sph__step_end(sph_world* w, sph_status s) {
 SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt) {
     sph_status s = sph__step_begin(w, dt, SPH_SOLVER_WCSPH);
     if (s != SPH_OK) return s;
+    if (w->def.scheme == SPH_SCHEME_SECOND_ORDER) {
+        s = sph__soc_check(w);
+        if (s != SPH_OK) return s;
+        return sph__step_end(w, sph__step_soc(w, dt));
+    }
     if (w->def.integrator == SPH_INTEGRATOR_VERLET) return sph__step_end(w, sph__step_wcsph_verlet(w, dt));
     return sph__step_end(w, sph__step_wcsph_euler(w, dt));
 }

@@ -30,8 +30,11 @@ extern const th_test tests_iisph[];
 extern const th_test tests_iisph_long[]; /* long runs: only with --long (make validate) */
 extern const th_test tests_pcisph[];
 extern const th_test tests_pcisph_long[];
+extern const th_test tests_operators[];
 extern const th_test tests_compressible[];
 extern const th_test tests_compressible_long[];
+extern const th_test tests_soc[];
+extern const th_test tests_soc_long[];
 
 void th_fail(const char* file, int line, const char* fmt, ...);
 void th_note(const char* fmt, ...);
