@@ -15,6 +15,20 @@
 
 /* ---- helpers ------------------------------------------------------------------------------- */
 
+/* Adds a phase (C++-compatible: no compound literals in the tests). */
+static int add_phase(sph_world* w, double rho0, sph_eos eos, double gamma, double c0, double pb,
+                     double nu) {
+    sph_phase ph;
+    memset(&ph, 0, sizeof ph);
+    ph.rest_density = (sph_real)rho0;
+    ph.eos = eos;
+    ph.gamma = (sph_real)gamma;
+    ph.sound_speed = (sph_real)c0;
+    ph.back_pressure = (sph_real)pb;
+    ph.viscosity = (sph_real)nu;
+    return sph_world_add_phase(w, &ph);
+}
+
 /* Adds the particles of [x0, x1) at spacing dx (centred in their cells), density rho, mass
    rho dx: a 1D line of one phase. */
 static int line(sph_world* w, int phase, double x0, double x1, double dx, double rho) {
@@ -188,14 +202,8 @@ static tube_result shock_tube(double dx, sph_density density, sph_pressure_grad 
     def.domain_lo[0] = (sph_real)-0.8;
     def.domain_hi[0] = (sph_real)2.2;
     CHECK(sph_world_init(&w, &def) == SPH_OK);
-    air = sph_world_add_phase(&w, &(sph_phase){.rest_density = (sph_real)88.1,
-                                               .eos = SPH_EOS_IDEAL_GAS,
-                                               .back_pressure = (sph_real)1e7});
-    diesel = sph_world_add_phase(&w, &(sph_phase){.rest_density = (sph_real)772.546,
-                                                  .eos = SPH_EOS_STIFFENED_GAS,
-                                                  .gamma = 11,
-                                                  .sound_speed = (sph_real)1059.6,
-                                                  .back_pressure = (sph_real)5e6});
+    air = add_phase(&w, (sph_real)88.1, SPH_EOS_IDEAL_GAS, 0, 0, (sph_real)1e7, 0);
+    diesel = add_phase(&w, (sph_real)772.546, SPH_EOS_STIFFENED_GAS, 11, (sph_real)1059.6, (sph_real)5e6, 0);
     CHECK(air >= 0 && diesel >= 0);
     CHECK(line(&w, air, -0.8, 0, dx, 88.1));
     CHECK(line(&w, diesel, 0, 2.2, dx, 772.546));
@@ -308,7 +316,7 @@ static void test_shock_tube(void) {
     /* the density plateau is 0.027 low at this resolution (outside the paper's 0.02); it is
        inside at 200/m, below. Total energy is conserved to round-off. */
     CHECK_NEAR(r.drho, drho_ex, 0.04);
-    CHECK(fabs(r.energy_drift) < 1e-12);
+    CHECK(fabs(r.energy_drift) < (sizeof(sph_real) == 4 ? 1e-6 : 1e-12));
     CHECK_NEAR(r.rho_air, ex.rho_star_L, 0.03 * ex.rho_star_L);
 
     /* 200/m: every Table 2 quantity within the paper's bars */
@@ -393,7 +401,7 @@ static sph_status advection(sph_density density, double xmin, double err[5], dou
     def.beta = 0;
     def.delta = 0;
     CHECK(sph_world_init(&w, &def) == SPH_OK);
-    ph = sph_world_add_phase(&w, &(sph_phase){.rest_density = 1, .eos = SPH_EOS_IDEAL_GAS});
+    ph = add_phase(&w, 1, SPH_EOS_IDEAL_GAS, 0, 0, 0, 0);
     for (i = 0; i < n; ++i) {
         x[i] = (sph_real)(xmin + (i + 0.5) * 0.1);
         r[i] = (sph_real)adv_rho0((double)x[i]);
@@ -518,7 +526,7 @@ static wave_result sound_wave(sph_density density, svg_chart* ch, const char* la
     def.domain_lo[0] = (sph_real)lo;
     def.domain_hi[0] = (sph_real)hi;
     CHECK(sph_world_init(&w, &def) == SPH_OK);
-    gas = sph_world_add_phase(&w, &(sph_phase){.rest_density = 1, .eos = SPH_EOS_IDEAL_GAS, .back_pressure = 1});
+    gas = add_phase(&w, 1, SPH_EOS_IDEAL_GAS, 0, 0, 1, 0);
     for (i = 0; i < n; ++i) {
         const double xi = lo + ((double)i + 0.5) * dx, rb = xi < 0 ? 10 : 1, cb = sqrt(g / rb);
         const double pp = xi > 0 ? A * exp(-((xi - xc) / sig) * ((xi - xc) / sig)) : 0;
@@ -642,7 +650,7 @@ static double sod(int dim, double* energy_drift, double* momentum, sph_status* s
         free(r);
         return 1;
     }
-    gas = sph_world_add_phase(&w, &(sph_phase){.rest_density = 1, .eos = SPH_EOS_IDEAL_GAS, .back_pressure = 1});
+    gas = add_phase(&w, 1, SPH_EOS_IDEAL_GAS, 0, 0, 1, 0);
     for (iz = 0; iz < nz; ++iz)
         for (iy = 0; iy < ny; ++iy)
             for (ix = 0; ix < nx; ++ix, ++i) {
@@ -715,22 +723,19 @@ static void test_gas_phase_rules(void) {
     def.spacing = (sph_real)0.05;
     CHECK(sph_world_init(&w, &def) == SPH_OK);
     /* an ideal gas's sound speed follows from its state */
-    CHECK(sph_world_add_phase(&w, &(sph_phase){.rest_density = 1, .eos = SPH_EOS_IDEAL_GAS,
-                                               .back_pressure = 1, .sound_speed = 3}) < 0);
+    CHECK(add_phase(&w, 1, SPH_EOS_IDEAL_GAS, 0, 3, 1, 0) < 0);
     CHECK(w.status == SPH_ERR_ARG && strstr(w.error, "sound_speed"));
-    CHECK(sph_world_add_phase(&w, &(sph_phase){.rest_density = 1, .eos = SPH_EOS_IDEAL_GAS,
-                                               .back_pressure = -1}) < 0);
+    CHECK(add_phase(&w, 1, SPH_EOS_IDEAL_GAS, 0, 0, -1, 0) < 0);
     CHECK(strstr(w.error, "back_pressure") != NULL);
-    CHECK(sph_world_add_phase(&w, &(sph_phase){.rest_density = 1, .eos = SPH_EOS_IDEAL_GAS, .gamma = 1}) < 0);
+    CHECK(add_phase(&w, 1, SPH_EOS_IDEAL_GAS, 1, 0, 0, 0) < 0);
     CHECK(strstr(w.error, "gamma") != NULL);
     /* a stiffened gas needs c0, and p_inf = rho0 c0^2/gamma - p_b must not be negative */
-    CHECK(sph_world_add_phase(&w, &(sph_phase){.rest_density = 1000, .eos = SPH_EOS_STIFFENED_GAS}) < 0);
+    CHECK(add_phase(&w, 1000, SPH_EOS_STIFFENED_GAS, 0, 0, 0, 0) < 0);
     CHECK(strstr(w.error, "sound_speed") != NULL);
-    CHECK(sph_world_add_phase(&w, &(sph_phase){.rest_density = 1, .eos = SPH_EOS_STIFFENED_GAS,
-                                               .sound_speed = 1, .back_pressure = 10}) < 0);
+    CHECK(add_phase(&w, 1, SPH_EOS_STIFFENED_GAS, 0, 1, 10, 0) < 0);
     CHECK(strstr(w.error, "p_inf") != NULL);
     CHECK(w.nphase == 0 && w.e == NULL);
-    gas = sph_world_add_phase(&w, &(sph_phase){.rest_density = 1, .eos = SPH_EOS_IDEAL_GAS, .back_pressure = 1});
+    gas = add_phase(&w, 1, SPH_EOS_IDEAL_GAS, 0, 0, 1, 0);
     CHECK(gas == 0 && w.e != NULL);
     CHECK_NEAR((double)w.phases[gas].sound_speed, sqrt(1.4), 1e-6);
     CHECK(sph_fill_box(&w, gas, lo, hi) == SPH_OK);
@@ -805,10 +810,8 @@ static rest_result interface_at_rest(sph_density density, double t_end) {
     def.domain_lo[1] = -1;
     def.domain_hi[1] = 2;
     CHECK(sph_world_init(&w, &def) == SPH_OK);
-    idx[0] = sph_world_add_phase(&w, &(sph_phase){.rest_density = 1000, .sound_speed = (sph_real)cw,
-                                                  .back_pressure = (sph_real)pb});
-    idx[1] = sph_world_add_phase(&w, &(sph_phase){.rest_density = 1, .sound_speed = 150,
-                                                  .gamma = (sph_real)1.4, .back_pressure = (sph_real)pb});
+    idx[0] = add_phase(&w, 1000, SPH_EOS_TAIT, 0, (sph_real)cw, (sph_real)pb, 0);
+    idx[1] = add_phase(&w, 1, SPH_EOS_TAIT, (sph_real)1.4, 150, (sph_real)pb, 0);
     for (ph = 0; ph < 2; ++ph) {
         const double rho0 = ph ? 1 : 1000;
         size_t q = 0;
@@ -897,7 +900,7 @@ static void test_compressible_determinism(void) {
     for (t = 1; t <= 2; ++t) {
         sph_world* w = t == 1 ? &a : &b;
         sph_world_def def = sph_world_def_default(2);
-        const sph_real lo[2] = {0, 0}, mid[2] = {1, (sph_real)0.5}, hi[2] = {1, 1};
+        const sph_real lo[2] = {0, 0}, mid[2] = {1, (sph_real)0.5}, mid0[2] = {0, (sph_real)0.5}, hi[2] = {1, 1};
         int gas, liq, k;
         size_t i;
         omp_set_num_threads(t);
@@ -914,11 +917,10 @@ static void test_compressible_determinism(void) {
             def.domain_hi[k] = 1;
         }
         CHECK_EQ_INT(sph_world_init(w, &def), SPH_OK);
-        liq = sph_world_add_phase(w, &(sph_phase){.rest_density = 100, .eos = SPH_EOS_STIFFENED_GAS,
-                                                  .sound_speed = 10, .back_pressure = 1});
-        gas = sph_world_add_phase(w, &(sph_phase){.rest_density = 1, .eos = SPH_EOS_IDEAL_GAS, .back_pressure = 1});
+        liq = add_phase(w, 100, SPH_EOS_STIFFENED_GAS, 0, 10, 1, 0);
+        gas = add_phase(w, 1, SPH_EOS_IDEAL_GAS, 0, 0, 1, 0);
         CHECK_EQ_INT(sph_fill_box(w, liq, lo, mid), SPH_OK);
-        CHECK_EQ_INT(sph_fill_box(w, gas, (const sph_real[2]){0, (sph_real)0.5}, hi), SPH_OK);
+        CHECK_EQ_INT(sph_fill_box(w, gas, mid0, hi), SPH_OK);
         for (i = 0; i < w->n; ++i) { /* ten times the pressure in a disc in the gas */
             const double dx = (double)w->x[2 * i] - 0.5, dy = (double)w->x[2 * i + 1] - 0.75;
             if (w->phase[i] == gas && dx * dx + dy * dy < 0.01) w->e[i] *= 10;
