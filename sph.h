@@ -233,7 +233,8 @@ int main(void) {
    WHAT IT DOES NOT DO (yet)
    No surface tension, no turbulence model, no rigid-body coupling (boundaries move kinematically),
    no adaptive resolution, no GPU. A 1000:1 interface touching a side wall does not stay at rest
-   (the contact line breaks up within 0.2 s); periodic side boundaries do.
+   (the contact line breaks up within 0.2 s); with periodic sides it stays at rest for about 2 s,
+   then a slowly growing mode breaks it (tests/test_compressible.c).
 */
 /* ============================================================================================== */
 /* >>config                                                                                       */
