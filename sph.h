@@ -130,7 +130,9 @@ int main(void) {
    does; no walls, no delta-SPH or artificial viscosity. Velocity converges at second order on
    Taylor-Green (tests/test_soc.c; bench/convergence.c: the study at c0 = 20, 40, 80, with run
    times); the price is the correction matrices, two force stages per step and the shifting,
-   and momentum is conserved only to O(h^2). The operators are public (>>operators).
+   and momentum is not conserved exactly (the corrected operators and the Taylor correction are
+   not pairwise antisymmetric: |sum v| / sum |v| reaches 1e-5 ... 3e-4 by t = 0.5 on
+   Taylor-Green). The operators are public (>>operators).
 
    SOLVER: PCISPH (sph_step_pcisph; sph_world_def_pcisph(&def, enhanced) sets it up)
    Predict-correct loop (Solenthaler & Pajarola 2009, seed 000): pressures are corrected from
@@ -499,7 +501,8 @@ typedef enum sph_wcsph_scheme {
                                 viscosity, fluid density apart from the Shepard volume, RK2
                                 midpoint, iterative shifting every def.shift_every steps with
                                 Taylor-corrected fields; every direction periodic, no walls.
-                                Second order in space (tests/test_soc.c, bench soc)      */
+                                Second order in space (tests/test_soc.c,
+                                bench/convergence.c)                                     */
 } sph_wcsph_scheme;
 
 typedef enum sph_viscosity_form {
@@ -3832,8 +3835,8 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
    with chi = h^d sum_j W_ij (chi_0 its lattice value; the paper leaves epsilon open), and each
    iteration Taylor-corrects u and rho with their corrected gradients at the positions before
    it moved (eq. 22; p follows from rho). No delta-SPH term, no artificial viscosity: the
-   scheme is what converges. The corrected operators do not conserve momentum exactly; the
-   drift is O(h^2) and reported by the tests. */
+   scheme is what converges. The corrected operators do not conserve momentum exactly (the
+   tests report the drift). */
 static sph_status sph__soc_check(sph_world* w) {
     int k;
     for (k = 0; k < w->dim; ++k)
