@@ -791,7 +791,7 @@ SPHDEF sph_status sph_add_fluid(sph_world* w, int phase, size_t n, const sph_rea
 /* The same with a mass m[i] [kg] and a density rho[i] [kg/m^3] per particle (either NULL: the
    phase's mass, the rest density). Particles of a gas phase start at its back pressure (their
    internal energy follows from the density); the Tait and linear laws give the pressure of the
-   density. New particles take indices old w.n .. w.n - 1 until the next step sorts them, so a
+   density. New particles take indices from the old w.n up until the next step sorts them, so a
    host may set w.e (or any state) of the particles it just added. */
 SPHDEF sph_status sph_add_fluid_ex(sph_world* w, int phase, size_t n, const sph_real* x,
                                    const sph_real* v, const sph_real* m, const sph_real* rho);
