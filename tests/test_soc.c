@@ -74,8 +74,10 @@ static void test_soc_taylor_green(void) {
     CHECK(fabs(b.ke_ratio - 1) < 0.05);
     CHECK(fabs(b.ke_ratio - 1) < 0.35 * fabs(a.ke_ratio - 1));
     /* the corrected operators do not conserve momentum exactly (seed 002: F_T/F_max 1e-5..1e-4);
-       the drift is bounded here, not asserted to vanish */
-    CHECK(b.momentum < 1e-3);
+       the drift is bounded here, not asserted to vanish. In float the non-cancelling round-off
+       of the asymmetric sums dominates it (2e-3 at 20^2 and 40^2, against 9e-6 and 3e-4 in
+       double), hence the separate bound. */
+    CHECK(b.momentum < (sizeof(sph_real) == 4 ? 1e-2 : 1e-3));
     CHECK(plain.status != SPH_OK || plain.l1_u > 3 * a.l1_u);
 }
 
@@ -159,7 +161,7 @@ static void test_soc_3d(void) {
         l1 += fabs(sqrt(su * su + sv * sv) - sqrt(u * u + v * v)) / (double)w.n;
         vz = fmax(vz, fabs((double)w.v[3 * i + 2]));
     }
-    TH_NOTE("3D slab %d^2 x %d, t = %.1f: L1(|u|) %.3e (2D: %.3e), max |w| %.1e", N, nz, t_end, l1,
+    TH_NOTE("3D slab %d^2 x %d, t = %.2f: L1(|u|) %.3e (2D: %.3e), max |w| %.1e", N, nz, t_end, l1,
             r2.l1_u, vz);
     CHECK(fabs(l1 - r2.l1_u) < 0.1 * r2.l1_u);
     CHECK(vz < 1e-3);
