@@ -2299,52 +2299,43 @@ static int sph__all_finite(const sph_real* a, size_t count, size_t* bad) {
     return 1;
 }
 
-SPHDEF sph_status sph_add_fluid(sph_world* w, int phase, size_t n, const sph_real* x,
-                                const sph_real* v) {
+/* The checks both ways of adding fluid share; fn names the caller in the message. */
+static sph_status sph__add_fluid_checked(sph_world* w, const char* fn, int phase, size_t n,
+                                         const sph_real* x, const sph_real* v, const sph_real* m,
+                                         const sph_real* rho) {
     size_t bad = 0, dim;
     if (!w) return SPH_ERR_ARG;
     if (!sph__check_phase(w, phase)) return SPH_ERR_ARG;
     if (n == 0) return SPH_OK;
-    if (!x) return sph__fail(w, SPH_ERR_ARG, -1, "sph_add_fluid: x is NULL");
+    if (!x) return sph__fail(w, SPH_ERR_ARG, -1, "%s: x is NULL", fn);
     dim = (size_t)w->dim;
     if (!sph__all_finite(x, n * dim, &bad))
         return sph__fail(w, SPH_ERR_ARG, (long)(bad / dim),
-                         "sph_add_fluid: x of particle %zu is not finite (%g)", bad / dim,
-                         (double)x[bad]);
+                         "%s: x of particle %zu is not finite (%g)", fn, bad / dim, (double)x[bad]);
     if (v && !sph__all_finite(v, n * dim, &bad))
         return sph__fail(w, SPH_ERR_ARG, (long)(bad / dim),
-                         "sph_add_fluid: v of particle %zu is not finite (%g)", bad / dim,
-                         (double)v[bad]);
-    return sph__append_fluid(w, phase, n, x, v, w->phases[phase].mass, NULL, NULL);
+                         "%s: v of particle %zu is not finite (%g)", fn, bad / dim, (double)v[bad]);
+    for (bad = 0; m && bad < n; ++bad)
+        if (!sph__finite((double)m[bad]) || !(m[bad] > 0))
+            return sph__fail(w, SPH_ERR_ARG, (long)bad,
+                             "%s: mass of particle %zu is %g: must be finite and > 0", fn, bad,
+                             (double)m[bad]);
+    for (bad = 0; rho && bad < n; ++bad)
+        if (!sph__finite((double)rho[bad]) || !(rho[bad] > 0))
+            return sph__fail(w, SPH_ERR_ARG, (long)bad,
+                             "%s: density of particle %zu is %g: must be finite and > 0", fn, bad,
+                             (double)rho[bad]);
+    return sph__append_fluid(w, phase, n, x, v, w->phases[phase].mass, m, rho);
+}
+
+SPHDEF sph_status sph_add_fluid(sph_world* w, int phase, size_t n, const sph_real* x,
+                                const sph_real* v) {
+    return sph__add_fluid_checked(w, "sph_add_fluid", phase, n, x, v, NULL, NULL);
 }
 
 SPHDEF sph_status sph_add_fluid_ex(sph_world* w, int phase, size_t n, const sph_real* x,
                                    const sph_real* v, const sph_real* m, const sph_real* rho) {
-    size_t bad = 0, dim;
-    if (!w) return SPH_ERR_ARG;
-    if (!sph__check_phase(w, phase)) return SPH_ERR_ARG;
-    if (n == 0) return SPH_OK;
-    if (!x) return sph__fail(w, SPH_ERR_ARG, -1, "sph_add_fluid_ex: x is NULL");
-    dim = (size_t)w->dim;
-    if (!sph__all_finite(x, n * dim, &bad))
-        return sph__fail(w, SPH_ERR_ARG, (long)(bad / dim),
-                         "sph_add_fluid_ex: x of particle %zu is not finite (%g)", bad / dim,
-                         (double)x[bad]);
-    if (v && !sph__all_finite(v, n * dim, &bad))
-        return sph__fail(w, SPH_ERR_ARG, (long)(bad / dim),
-                         "sph_add_fluid_ex: v of particle %zu is not finite (%g)", bad / dim,
-                         (double)v[bad]);
-    for (bad = 0; m && bad < n; ++bad)
-        if (!sph__finite((double)m[bad]) || !(m[bad] > 0))
-            return sph__fail(w, SPH_ERR_ARG, (long)bad,
-                             "sph_add_fluid_ex: mass of particle %zu is %g: must be finite and > 0",
-                             bad, (double)m[bad]);
-    for (bad = 0; rho && bad < n; ++bad)
-        if (!sph__finite((double)rho[bad]) || !(rho[bad] > 0))
-            return sph__fail(w, SPH_ERR_ARG, (long)bad,
-                             "sph_add_fluid_ex: density of particle %zu is %g: must be finite and > 0",
-                             bad, (double)rho[bad]);
-    return sph__append_fluid(w, phase, n, x, v, w->phases[phase].mass, m, rho);
+    return sph__add_fluid_checked(w, "sph_add_fluid_ex", phase, n, x, v, m, rho);
 }
 
 static sph_status sph__check_box(sph_world* w, const char* fn, const sph_real* lo,

@@ -739,6 +739,14 @@ static void test_gas_phase_rules(void) {
     CHECK(gas == 0 && w.e != NULL);
     CHECK_NEAR((double)w.phases[gas].sound_speed, sqrt(1.4), 1e-6);
     CHECK(sph_fill_box(&w, gas, lo, hi) == SPH_OK);
+    { /* per-particle masses and densities are checked, and a rejection adds nothing */
+        const sph_real px[1] = {(sph_real)0.5}, bad_m[1] = {-1}, bad_r[1] = {0};
+        const size_t n0 = w.n;
+        CHECK(sph_add_fluid_ex(&w, gas, 1, px, NULL, bad_m, NULL) == SPH_ERR_ARG);
+        CHECK(strstr(w.error, "sph_add_fluid_ex: mass") != NULL);
+        CHECK(sph_add_fluid_ex(&w, gas, 1, px, NULL, NULL, bad_r) == SPH_ERR_ARG);
+        CHECK(strstr(w.error, "density") != NULL && w.n == n0);
+    }
     /* particles start at the back pressure: e = p / ((gamma - 1) rho) */
     CHECK_NEAR((double)w.e[3], 1 / 0.4, 1e-6);
     /* the other solvers refuse a gas phase and leave the world as it was */
