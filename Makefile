@@ -6,6 +6,9 @@
 #   make validate  the long validation runs (tests marked long)
 #   make bench     throughput (bench/bench.c) and the Taylor-Green convergence study
 #                  (bench/convergence.c), results in bench/results/; BENCH_N=40 for a quick run
+#   make paraview  the dam break as a ParaView time series: out/paraview/dambreak.pvd
+#   make install   sph.h and sph.pc (pkg-config) under PREFIX (default /usr/local); CMake users
+#                  can instead add_subdirectory() this directory (CMakeLists.txt) or install it
 
 CC      ?= cc
 CXX     ?= c++
@@ -19,16 +22,18 @@ B        = build
 
 TEST_SRC = tests/main.c tests/impl.c tests/test_kernels.c tests/test_grid.c tests/test_operators.c \
            tests/test_world.c tests/test_wcsph.c tests/test_pcisph.c tests/test_iisph.c \
-           tests/test_compressible.c tests/test_soc.c \
+           tests/test_compressible.c tests/test_soc.c tests/test_io.c \
            tests/test_compile.c \
            tests/compile_second.c \
            tests/compile_static.c
 TEST_CXX = tests/compile_cpp.cpp
 TEST_DEP = sph.h tests/harness.h tests/riemann.h bench/svg.h examples/scenes.h $(TEST_SRC) $(TEST_CXX)
-EXAMPLES = hello dambreak
+EXAMPLES = hello dambreak paraview
+PREFIX  ?= /usr/local
+VTK_PYTHON ?= /usr/bin/python3
 
-.PHONY: test validate bench demo examples check check-warnings check-sanitize check-float check-noomp \
-        check-cpp check-png clean
+.PHONY: test validate bench demo paraview examples install check check-warnings check-sanitize \
+        check-float check-noomp check-cpp check-png check-vtk check-integration clean
 
 test: $(B)/tests
 	./$(B)/tests
@@ -56,7 +61,19 @@ $(B)/convergence: bench/convergence.c sph.h examples/scenes.h bench/svg.h | $(B)
 demo: $(B)/dambreak
 	./$(B)/dambreak
 
+paraview: $(B)/paraview
+	mkdir -p out/paraview
+	./$(B)/paraview 2d 1.0 out/paraview
+
 examples: $(addprefix $(B)/,$(EXAMPLES))
+
+# The header and a pkg-config file (the same sph.pc.in as CMake's install uses).
+install:
+	install -d $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/share/pkgconfig
+	install -m 644 sph.h $(DESTDIR)$(PREFIX)/include/sph.h
+	v=$$(sed -n 's/^#define SPH_VERSION_[A-Z]* \([0-9]*\)$$/\1/p' sph.h | paste -sd.); \
+	sed -e 's|@SPH_PC_PREFIX@|$(PREFIX)|' -e 's|@SPH_PC_INCLUDEDIR@|$(PREFIX)/include|' \
+	    -e "s|@SPH_PC_VERSION@|$$v|" sph.pc.in > $(DESTDIR)$(PREFIX)/share/pkgconfig/sph.pc
 
 $(B)/%: examples/%.c sph.h examples/scenes.h examples/image.h | $(B)
 	$(CC) $(CFLAGS) $(OMP) -I. $< -o $@ -lm
@@ -65,7 +82,8 @@ $(B):
 	mkdir -p $(B) out
 
 # ---- check: the quality bar --------------------------------------------------------------------
-check: check-warnings check-sanitize check-float check-noomp check-cpp check-png
+check: check-warnings check-sanitize check-float check-noomp check-cpp check-png check-vtk \
+       check-integration
 
 IMPL_C = printf '\#define SPH_IMPLEMENTATION\n\#include "sph.h"\nint main(void){return 0;}\n'
 
@@ -108,6 +126,20 @@ check-png: | $(B)
 	$(CC) $(CFLAGS) tests/png_check.c -o $(B)/png_check -lm
 	./$(B)/png_check $(B)
 	python3 tests/check_png.py $(B)
+
+# The ParaView writer read back by VTK itself (python3-vtk9; Debian's /usr/bin/python3), double
+# and float builds.
+check-vtk: | $(B)
+	$(CC) $(CFLAGS) -I. tests/vtk_export.c -o $(B)/vtk_export -lm
+	$(CC) $(CFLAGS) -DSPH_FLOAT -I. tests/vtk_export.c -o $(B)/vtk_export_f -lm
+	rm -rf $(B)/vtk $(B)/vtk_f && mkdir -p $(B)/vtk $(B)/vtk_f
+	./$(B)/vtk_export $(B)/vtk && ./$(B)/vtk_export_f $(B)/vtk_f
+	$(VTK_PYTHON) tests/check_vtk.py $(B)/vtk
+	$(VTK_PYTHON) tests/check_vtk.py $(B)/vtk_f
+
+# CMake add_subdirectory / find_package, pkg-config and make install, each with a tiny consumer.
+check-integration:
+	tests/check_integration.sh $(CURDIR)/$(B)/integration
 
 clean:
 	rm -rf $(B) out

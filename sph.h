@@ -27,7 +27,7 @@
        >>pcisph        sph_step_pcisph, sph_world_def_pcisph
        >>iisph         sph_step_iisph
        >>compressible  sph_step_compressible, sph_add_fluid_ex (gases, shocks, large density ratios)
-       >>io            sph_write_csv, sph_write_vtk
+       >>io            sph_write_csv, sph_write_vtu, sph_write_vtu_series (ParaView), sph_write_vtk
 
    COMPILE-TIME OPTIONS (define before including the implementation)
        SPH_FLOAT          sph_real is float instead of double
@@ -293,6 +293,7 @@ typedef enum sph_status {
     SPH_ERR_CAPACITY,      /* a count exceeds what the library can index (2^32-1 particles)     */
     SPH_ERR_UNSTABLE,      /* a step produced a non-finite value or a runaway density/speed     */
     SPH_ERR_NOT_CONVERGED, /* an iterative solver reached its iteration limit                   */
+    SPH_ERR_IO,            /* a file could not be opened, written or read (errno says why)      */
     SPH_STATUS_COUNT
 } sph_status;
 
@@ -876,9 +877,29 @@ SPHDEF sph_status sph_step_compressible(sph_world* w, sph_real dt);
 /* >>io                                                                                           */
 /* ============================================================================================== */
 
-/* Fluid particles as CSV: id,phase,x,y[,z],vx,vy[,vz],rho,p[,e] (e with gas phases). */
+/* The writers take a const world and change nothing: SPH_ERR_ARG for a NULL argument or a bad
+   frame number, SPH_ERR_IO when a file cannot be opened or written (errno says why) or when the
+   .pvd to extend is not one this library wrote. Call them between steps, on one thread. */
+
+/* Fluid particles as CSV: id,phase,x,y[,z],vx,vy[,vz],rho,p[,e] (e with gas phases), 9 digits. */
 SPHDEF sph_status sph_write_csv(const sph_world* w, const char* path);
-/* Fluid and boundary particles as a legacy ASCII VTK unstructured grid (opens in ParaView). */
+/* Fluid and boundary particles as one VTK XML unstructured grid (.vtu; ParaView, VisIt, VTK):
+   points in 3D (z = 0 in 2D, y = z = 0 in 1D), one vertex cell per particle, and the point data
+   velocity (3 components) [m/s], density [kg/m^3], pressure [Pa], id, phase (-1 on walls),
+   kind (0 fluid, 1 boundary), body (the wall's body tag, -1 for fluid) and internal_energy
+   [J/kg] when the world has gas phases; the time [s] as the field TimeValue. Binary (raw
+   appended, the machine's byte order, 64-bit block headers) and exact: reals are written in
+   sph_real's precision (Float64, or Float32 with SPH_FLOAT) and read back bit for bit. Walls
+   carry their velocity, extrapolated pressure and density (rho_b / rho0 times phase 0's rest
+   density). Allocates nothing. */
+SPHDEF sph_status sph_write_vtu(const sph_world* w, const char* path);
+/* One frame of a time series: writes <base>_<frame>.vtu (frame with 4 digits, more if needed)
+   and lists it with w->time in the ParaView collection <base>.pvd. frame 0 creates the .pvd;
+   a later frame appends its entry, so the .pvd is complete after every call. base may contain
+   directories (they must exist); the .pvd names each .vtu relative to itself. frame >= 0. */
+SPHDEF sph_status sph_write_vtu_series(const sph_world* w, const char* base, int frame);
+/* Fluid and boundary particles as a legacy ASCII VTK unstructured grid (.vtk; 9 digits): the
+   same point data as sph_write_vtu without body. Larger and lossy; kept for old readers. */
 SPHDEF sph_status sph_write_vtk(const sph_world* w, const char* path);
 
 #ifdef __cplusplus
@@ -1013,6 +1034,7 @@ SPHDEF const char* sph_status_string(sph_status status) {
     case SPH_ERR_CAPACITY: return "capacity exceeded";
     case SPH_ERR_UNSTABLE: return "simulation unstable";
     case SPH_ERR_NOT_CONVERGED: return "solver did not converge";
+    case SPH_ERR_IO: return "input/output error";
     default: return "unknown status";
     }
 }
@@ -4960,7 +4982,7 @@ SPHDEF sph_status sph_write_csv(const sph_world* w, const char* path) {
     int k;
     if (!w || !path) return SPH_ERR_ARG;
     f = fopen(path, "w");
-    if (!f) return SPH_ERR_ARG;
+    if (!f) return SPH_ERR_IO;
     fprintf(f, "id,phase");
     for (k = 0; k < w->dim; ++k) fprintf(f, ",%c", names[k]);
     for (k = 0; k < w->dim; ++k) fprintf(f, ",v%c", names[k]);
@@ -4973,7 +4995,200 @@ SPHDEF sph_status sph_write_csv(const sph_world* w, const char* path) {
         if (w->e) fprintf(f, ",%.9g", (double)w->e[i]);
         fputc('\n', f);
     }
-    return fclose(f) == 0 ? SPH_OK : SPH_ERR_ARG;
+    if (ferror(f)) { fclose(f); return SPH_ERR_IO; }
+    return fclose(f) == 0 ? SPH_OK : SPH_ERR_IO;
+}
+
+/* VTK XML unstructured grid (.vtu), "raw appended" binary: the XML header declares every array
+   with its byte offset into the block after <AppendedData encoding="raw"> _ ; each array there is
+   a UInt64 byte count followed by the values in the machine's byte order. The values are written
+   in chunks through a small buffer on the stack, so writing allocates nothing. */
+#define SPH__VTU_CHUNK 512
+
+/* A wall particle's density for output: its extrapolated rho_b / rho0 times the rest density of
+   phase 0 (with several phases each phase sees its own wall density; phase 0's is written). */
+static sph_real sph__wall_density(const sph_world* w, size_t b) {
+    return w->b_rho[b] * (w->nphase > 0 ? w->phases[0].rest_density : (sph_real)1);
+}
+
+typedef struct sph__vtu {
+    FILE* f;
+    const sph_world* w;
+    size_t n;           /* fluid + boundary particles                                      */
+    uint64_t offset;    /* running offset of the next array in the appended block [bytes] */
+} sph__vtu;
+
+enum { SPH__VTU_POS, SPH__VTU_VEL, SPH__VTU_RHO, SPH__VTU_P, SPH__VTU_E, SPH__VTU_ID,
+       SPH__VTU_PHASE, SPH__VTU_KIND, SPH__VTU_BODY, SPH__VTU_CONN, SPH__VTU_OFFS,
+       SPH__VTU_TYPES, SPH__VTU_COUNT };
+
+/* VTK type name and bytes per component of array a. */
+static const char* sph__vtu_type(const sph__vtu* o, int a, size_t* size) {
+    switch (a) {
+    case SPH__VTU_POS: case SPH__VTU_VEL: case SPH__VTU_RHO: case SPH__VTU_P: case SPH__VTU_E:
+        *size = sizeof(sph_real);
+        return sizeof(sph_real) == 4 ? "Float32" : "Float64";
+    case SPH__VTU_ID: *size = 4; return "UInt32";
+    case SPH__VTU_PHASE: case SPH__VTU_BODY: *size = 4; return "Int32";
+    case SPH__VTU_KIND: case SPH__VTU_TYPES: *size = 1; return "UInt8";
+    default: /* connectivity and offsets: 32 bits while they fit */
+        *size = o->n < 0x7fffffffu ? 4 : 8;
+        return *size == 4 ? "Int32" : "Int64";
+    }
+}
+
+static int sph__vtu_comps(int a) { return a == SPH__VTU_POS || a == SPH__VTU_VEL ? 3 : 1; }
+
+static void sph__vtu_decl(sph__vtu* o, int a, const char* name) {
+    size_t size;
+    const char* type = sph__vtu_type(o, a, &size);
+    const int nc = sph__vtu_comps(a);
+    fprintf(o->f, "        <DataArray type=\"%s\"", type);
+    if (name) fprintf(o->f, " Name=\"%s\"", name);
+    if (nc > 1) fprintf(o->f, " NumberOfComponents=\"%d\"", nc);
+    fprintf(o->f, " format=\"appended\" offset=\"%llu\"/>\n", (unsigned long long)o->offset);
+    o->offset += 8 + (uint64_t)o->n * (uint64_t)nc * (uint64_t)size;
+}
+
+/* Component c of array a at particle i (fluid first, then boundary), as the bytes of its type. */
+static void sph__vtu_value(const sph__vtu* o, int a, size_t i, int c, size_t size,
+                           unsigned char* out) {
+    const sph_world* w = o->w;
+    const size_t d = (size_t)w->dim;
+    const int fluid = i < w->n;
+    const size_t b = fluid ? 0 : i - w->n;
+    sph_real r = 0;
+    uint32_t u = 0;
+    int32_t s = 0;
+    int64_t l = 0;
+    int32_t l4 = 0;
+    unsigned char k = 0;
+    switch (a) {
+    case SPH__VTU_POS:
+        if ((size_t)c < d) r = fluid ? w->x[i * d + (size_t)c] : w->b_x[b * d + (size_t)c];
+        memcpy(out, &r, sizeof r); return;
+    case SPH__VTU_VEL:
+        if ((size_t)c < d) r = fluid ? w->v[i * d + (size_t)c] : w->b_v[b * d + (size_t)c];
+        memcpy(out, &r, sizeof r); return;
+    case SPH__VTU_RHO: r = fluid ? w->rho[i] : sph__wall_density(w, b);
+        memcpy(out, &r, sizeof r); return;
+    case SPH__VTU_P: r = fluid ? w->p[i] : w->b_p[b]; memcpy(out, &r, sizeof r); return;
+    case SPH__VTU_E: r = fluid && w->e ? w->e[i] : 0; memcpy(out, &r, sizeof r); return;
+    case SPH__VTU_ID: u = fluid ? w->id[i] : w->b_id[b]; memcpy(out, &u, 4); return;
+    case SPH__VTU_PHASE: s = fluid ? (int32_t)w->phase[i] : -1; memcpy(out, &s, 4); return;
+    case SPH__VTU_BODY: s = fluid ? -1 : (int32_t)w->b_body[b]; memcpy(out, &s, 4); return;
+    case SPH__VTU_KIND: k = (unsigned char)(fluid ? 0 : 1); *out = k; return;
+    case SPH__VTU_TYPES: *out = 1; return; /* VTK_VERTEX */
+    default: /* connectivity i, offsets i + 1 (where each one-point cell ends) */
+        l = (int64_t)i + (a == SPH__VTU_OFFS);
+        l4 = (int32_t)l;
+        if (size == 4) memcpy(out, &l4, 4);
+        else memcpy(out, &l, 8);
+        return;
+    }
+}
+
+static void sph__vtu_data(sph__vtu* o, int a) {
+    unsigned char buf[SPH__VTU_CHUNK * 8];
+    size_t size, i, fill = 0;
+    const int nc = sph__vtu_comps(a);
+    uint64_t bytes;
+    int c;
+    (void)sph__vtu_type(o, a, &size);
+    bytes = (uint64_t)o->n * (uint64_t)nc * (uint64_t)size;
+    fwrite(&bytes, 8, 1, o->f);
+    for (i = 0; i < o->n; ++i)
+        for (c = 0; c < nc; ++c) {
+            sph__vtu_value(o, a, i, c, size, buf + fill);
+            fill += size;
+            if (fill + 8 > sizeof buf) { fwrite(buf, 1, fill, o->f); fill = 0; }
+        }
+    if (fill) fwrite(buf, 1, fill, o->f);
+}
+
+SPHDEF sph_status sph_write_vtu(const sph_world* w, const char* path) {
+    static const char* const names[SPH__VTU_COUNT] = {
+        NULL, "velocity", "density", "pressure", "internal_energy", "id", "phase", "kind", "body",
+        "connectivity", "offsets", "types"};
+    const uint16_t one = 1;
+    unsigned char first;
+    sph__vtu o;
+    int a;
+    if (!w || !path) return SPH_ERR_ARG;
+    o.f = fopen(path, "wb");
+    if (!o.f) return SPH_ERR_IO;
+    o.w = w;
+    o.n = w->n + w->nb;
+    o.offset = 0;
+    memcpy(&first, &one, 1);
+    fprintf(o.f, "<?xml version=\"1.0\"?>\n<!-- sph.h particles: fluid first, then boundary -->\n"
+                 "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"%s\" "
+                 "header_type=\"UInt64\">\n  <UnstructuredGrid>\n    <FieldData>\n"
+                 "      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" "
+                 "format=\"ascii\">%.17g</DataArray>\n    </FieldData>\n"
+                 "    <Piece NumberOfPoints=\"%llu\" NumberOfCells=\"%llu\">\n"
+                 "      <PointData Scalars=\"density\" Vectors=\"velocity\">\n",
+            first ? "LittleEndian" : "BigEndian", w->time, (unsigned long long)o.n,
+            (unsigned long long)o.n);
+    for (a = SPH__VTU_VEL; a <= SPH__VTU_BODY; ++a)
+        if (a != SPH__VTU_E || w->e) sph__vtu_decl(&o, a, names[a]);
+    fprintf(o.f, "      </PointData>\n      <Points>\n");
+    sph__vtu_decl(&o, SPH__VTU_POS, NULL);
+    fprintf(o.f, "      </Points>\n      <Cells>\n");
+    for (a = SPH__VTU_CONN; a <= SPH__VTU_TYPES; ++a) sph__vtu_decl(&o, a, names[a]);
+    fprintf(o.f, "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n"
+                 "  <AppendedData encoding=\"raw\">\n   _");
+    /* the same order as declared */
+    for (a = SPH__VTU_VEL; a <= SPH__VTU_BODY; ++a)
+        if (a != SPH__VTU_E || w->e) sph__vtu_data(&o, a);
+    sph__vtu_data(&o, SPH__VTU_POS);
+    for (a = SPH__VTU_CONN; a <= SPH__VTU_TYPES; ++a) sph__vtu_data(&o, a);
+    fprintf(o.f, "\n  </AppendedData>\n</VTKFile>\n");
+    if (ferror(o.f)) { fclose(o.f); return SPH_ERR_IO; }
+    return fclose(o.f) == 0 ? SPH_OK : SPH_ERR_IO;
+}
+
+/* The .pvd ends with this footer; a new frame overwrites it with its entry and the footer again,
+   so the file is a complete collection after every frame without keeping state between calls. */
+static const char sph__pvd_footer[] = "  </Collection>\n</VTKFile>\n";
+
+SPHDEF sph_status sph_write_vtu_series(const sph_world* w, const char* base, int frame) {
+    char path[4096], tail[sizeof sph__pvd_footer];
+    const size_t flen = sizeof sph__pvd_footer - 1;
+    const char* name = base;
+    const char* c;
+    FILE* f;
+    sph_status s;
+    int len;
+    if (!w || !base || frame < 0) return SPH_ERR_ARG;
+    for (c = base; *c; ++c)
+        if (*c == '/' || *c == '\\') name = c + 1;
+    len = snprintf(path, sizeof path, "%s_%04d.vtu", base, frame);
+    if (len < 0 || (size_t)len >= sizeof path) return SPH_ERR_ARG;
+    s = sph_write_vtu(w, path);
+    if (s != SPH_OK) return s;
+    len = snprintf(path, sizeof path, "%s.pvd", base);
+    if (len < 0 || (size_t)len >= sizeof path) return SPH_ERR_ARG;
+    if (frame == 0) {
+        f = fopen(path, "wb");
+        if (!f) return SPH_ERR_IO;
+        fprintf(f, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n"
+                   "  <Collection>\n");
+    } else {
+        /* extend an existing collection: its last bytes must be our footer */
+        f = fopen(path, "r+b");
+        if (!f) return SPH_ERR_IO;
+        if (fseek(f, -(long)flen, SEEK_END) != 0 || fread(tail, 1, flen, f) != flen ||
+            memcmp(tail, sph__pvd_footer, flen) != 0 || fseek(f, -(long)flen, SEEK_END) != 0) {
+            fclose(f);
+            return SPH_ERR_IO;
+        }
+    }
+    fprintf(f, "    <DataSet timestep=\"%.17g\" part=\"0\" file=\"%s_%04d.vtu\"/>\n", w->time,
+            name, frame);
+    fputs(sph__pvd_footer, f);
+    if (ferror(f)) { fclose(f); return SPH_ERR_IO; }
+    return fclose(f) == 0 ? SPH_OK : SPH_ERR_IO;
 }
 
 SPHDEF sph_status sph_write_vtk(const sph_world* w, const char* path) {
@@ -4982,7 +5197,7 @@ SPHDEF sph_status sph_write_vtk(const sph_world* w, const char* path) {
     int k;
     if (!w || !path) return SPH_ERR_ARG;
     f = fopen(path, "w");
-    if (!f) return SPH_ERR_ARG;
+    if (!f) return SPH_ERR_IO;
     n = w->n + w->nb;
     fprintf(f, "# vtk DataFile Version 3.0\nsph.h particles t=%.9g\nASCII\nDATASET UNSTRUCTURED_GRID\n",
             w->time);
@@ -5002,7 +5217,8 @@ SPHDEF sph_status sph_write_vtk(const sph_world* w, const char* path) {
     fprintf(f, "SCALARS phase int 1\nLOOKUP_TABLE default\n");
     for (i = 0; i < n; ++i) fprintf(f, "%d\n", i < w->n ? (int)w->phase[i] : -1);
     fprintf(f, "SCALARS density double 1\nLOOKUP_TABLE default\n");
-    for (i = 0; i < n; ++i) fprintf(f, "%.9g\n", i < w->n ? (double)w->rho[i] : (double)w->b_rho[i - w->n]);
+    for (i = 0; i < n; ++i)
+        fprintf(f, "%.9g\n", i < w->n ? (double)w->rho[i] : (double)sph__wall_density(w, i - w->n));
     fprintf(f, "SCALARS pressure double 1\nLOOKUP_TABLE default\n");
     for (i = 0; i < n; ++i) fprintf(f, "%.9g\n", i < w->n ? (double)w->p[i] : (double)w->b_p[i - w->n]);
     if (w->e) {
@@ -5014,7 +5230,8 @@ SPHDEF sph_status sph_write_vtk(const sph_world* w, const char* path) {
         const sph_real* v = i < w->n ? w->v + i * (size_t)w->dim : w->b_v + (i - w->n) * (size_t)w->dim;
         for (k = 0; k < 3; ++k) fprintf(f, "%.9g%c", k < w->dim ? (double)v[k] : 0.0, k < 2 ? ' ' : '\n');
     }
-    return fclose(f) == 0 ? SPH_OK : SPH_ERR_ARG;
+    if (ferror(f)) { fclose(f); return SPH_ERR_IO; }
+    return fclose(f) == 0 ? SPH_OK : SPH_ERR_IO;
 }
 
 #endif /* SPH__IMPLEMENTATION_ONCE */

@@ -35,6 +35,7 @@ extern const th_test tests_compressible[];
 extern const th_test tests_compressible_long[];
 extern const th_test tests_soc[];
 extern const th_test tests_soc_long[];
+extern const th_test tests_io[];
 
 void th_fail(const char* file, int line, const char* fmt, ...);
 void th_note(const char* fmt, ...);

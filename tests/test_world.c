@@ -497,7 +497,8 @@ static void test_write_csv_vtk(void) {
         fclose(f);
     }
     CHECK_EQ_INT(points, w.n + w.nb);
-    CHECK_EQ_INT(sph_write_csv(&w, "build/no/such/dir/x.csv"), SPH_ERR_ARG);
+    CHECK_EQ_INT(sph_write_csv(&w, "build/no/such/dir/x.csv"), SPH_ERR_IO);
+    CHECK_EQ_INT(sph_write_vtk(&w, "build/no/such/dir/x.vtk"), SPH_ERR_IO);
     sph_world_free(&w);
 }
 
