@@ -5153,36 +5153,41 @@ SPHDEF sph_status sph_write_vtu(const sph_world* w, const char* path) {
 static const char sph__pvd_footer[] = "  </Collection>\n</VTKFile>\n";
 
 SPHDEF sph_status sph_write_vtu_series(const sph_world* w, const char* base, int frame) {
-    char path[4096], tail[sizeof sph__pvd_footer];
+    char vtu[4096], pvd[4096], tail[sizeof sph__pvd_footer];
     const size_t flen = sizeof sph__pvd_footer - 1;
     const char* name = base;
     const char* c;
-    FILE* f;
+    FILE* f = NULL;
     sph_status s;
     int len;
     if (!w || !base || frame < 0) return SPH_ERR_ARG;
     for (c = base; *c; ++c)
         if (*c == '/' || *c == '\\') name = c + 1;
-    len = snprintf(path, sizeof path, "%s_%04d.vtu", base, frame);
-    if (len < 0 || (size_t)len >= sizeof path) return SPH_ERR_ARG;
-    s = sph_write_vtu(w, path);
-    if (s != SPH_OK) return s;
-    len = snprintf(path, sizeof path, "%s.pvd", base);
-    if (len < 0 || (size_t)len >= sizeof path) return SPH_ERR_ARG;
-    if (frame == 0) {
-        f = fopen(path, "wb");
-        if (!f) return SPH_ERR_IO;
-        fprintf(f, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n"
-                   "  <Collection>\n");
-    } else {
-        /* extend an existing collection: its last bytes must be our footer */
-        f = fopen(path, "r+b");
+    len = snprintf(vtu, sizeof vtu, "%s_%04d.vtu", base, frame);
+    if (len < 0 || (size_t)len >= sizeof vtu) return SPH_ERR_ARG;
+    len = snprintf(pvd, sizeof pvd, "%s.pvd", base);
+    if (len < 0 || (size_t)len >= sizeof pvd) return SPH_ERR_ARG;
+    if (frame > 0) {
+        /* extend an existing collection: its last bytes must be our footer (checked before the
+           frame is written, so a refused call writes nothing) */
+        f = fopen(pvd, "r+b");
         if (!f) return SPH_ERR_IO;
         if (fseek(f, -(long)flen, SEEK_END) != 0 || fread(tail, 1, flen, f) != flen ||
             memcmp(tail, sph__pvd_footer, flen) != 0 || fseek(f, -(long)flen, SEEK_END) != 0) {
             fclose(f);
             return SPH_ERR_IO;
         }
+    }
+    s = sph_write_vtu(w, vtu);
+    if (s != SPH_OK) {
+        if (f) fclose(f);
+        return s;
+    }
+    if (frame == 0) {
+        f = fopen(pvd, "wb");
+        if (!f) return SPH_ERR_IO;
+        fprintf(f, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n"
+                   "  <Collection>\n");
     }
     fprintf(f, "    <DataSet timestep=\"%.17g\" part=\"0\" file=\"%s_%04d.vtu\"/>\n", w->time,
             name, frame);

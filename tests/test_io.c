@@ -358,8 +358,13 @@ static void test_io_errors(void) {
     CHECK_EQ_INT(sph_write_vtu_series(&w, "build/no/such/dir/s", 0), SPH_ERR_IO);
     /* a later frame without the .pvd of frame 0 */
     remove("build/test_io_missing.pvd");
+    remove("build/test_io_missing_0001.vtu");
     CHECK_EQ_INT(sph_write_vtu_series(&w, "build/test_io_missing", 1), SPH_ERR_IO);
+    f = fopen("build/test_io_missing_0001.vtu", "rb"); /* a refused call writes nothing */
+    CHECK(f == NULL);
+    if (f) fclose(f);
     /* a .pvd that this library did not write is refused and left as it was */
+    remove("build/test_io_foreign_0001.vtu");
     f = fopen("build/test_io_foreign.pvd", "wb");
     CHECK(f != NULL);
     if (f) { fputs(foreign, f); fclose(f); }
@@ -367,6 +372,9 @@ static void test_io_errors(void) {
     text = slurp("build/test_io_foreign.pvd", &len);
     CHECK(text && strcmp(text, foreign) == 0);
     free(text);
+    f = fopen("build/test_io_foreign_0001.vtu", "rb");
+    CHECK(f == NULL);
+    if (f) fclose(f);
     CHECK_EQ_INT(sph_status_string(SPH_ERR_IO)[0] != 0, 1);
     sph_world_free(&w);
 }
