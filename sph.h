@@ -36,7 +36,7 @@
                           the allocator (define all three or none; default libc)
        SPH_ASSERT(cond)   internal invariants (default assert); never used for user input
        SPH_VALIDATE       expensive self-checks (neighbour-list symmetry), for tests
-       SPH_MAX_PHASES     phases per world (default 16)
+       SPH_MAX_PHASES     phases per world (default 16; at most 256, phase indices are uint8_t)
    OpenMP is used when the compiler enables it (-fopenmp); otherwise everything runs serially.
 
    QUICK START (examples/hello.c; the tests check that this text is that file):
@@ -100,7 +100,7 @@ int main(void) {
    nb, b_x, b_v, b_p ... directly; fluid positions and velocities may be written between steps.
    Move boundary particles from def.boundary_motion: static walls are sorted into their grid once,
    and only a motion callback (or adding particles) makes the library re-sort them.
-   Particles are reordered by cell at every step: follow one by its id, not by its index. Array
+   Particles may be reordered by cell at any step: follow one by its id, not by its index. Array
    pointers change only when particles are added. A per-particle mass array (w.m) exists only
    when particles of different mass coexist; otherwise every particle has mass w.mass.
 
@@ -183,13 +183,29 @@ int main(void) {
 
    CALLBACKS AND THREADS
    def.force: adds body accelerations for a range of fluid particles; called from worker threads
-   with disjoint ranges once per step, before the pressure and viscous forces; the wall pressure
+   with disjoint ranges once per force evaluation (once per step; twice with the second-order
+   scheme, once per RK2 stage), before the pressure and viscous forces; the wall pressure
    sees these accelerations like gravity. def.boundary_motion: called once per step on the
    calling thread before the neighbour search with the time of the force evaluation; sets b_x,
    b_v (and b_a, the wall acceleration) of moving boundary particles; b_x0 keeps each particle's
    reference position and b_body the tag given when it was added. Loops over particles are
    OpenMP parallel and gather-only (each particle writes only its own values); small worlds run
    on one thread.
+
+   THREAD SAFETY
+   The library keeps no global mutable state. sph_status_string and the sph_kernel_* functions
+   use only their arguments (sph_kernel_init writes *k): call them from any thread. Every other
+   function works on one world, grid or neighbour list; calls on different objects may run at
+   once from different threads, but a call that writes an object must not overlap any other call
+   on it. Writers: on a world, sph_world_init/_free, sph_world_add_phase, sph_fill_box,
+   sph_add_*, sph_set_hydrostatic, the steps, sph_advance and sph_stable_dt (it fills in
+   automatic sound speeds); on a grid, sph_grid_init/_build/_free; on lists,
+   sph_neighbors_build/_free. Readers may overlap each other: sph_grid_query, sph_grid_delta,
+   sph_op_* (each writing its own output array), sph_world_mass, _momentum, _memory and _error.
+   The host must not touch a world's arrays while a call on that world runs, except from the
+   callbacks as described above; def.force runs on several threads at once, so it must be safe
+   for that. The loops open ordinary OpenMP parallel regions, so OpenMP's rules for nesting apply
+   when a call runs inside a parallel region.
 
    MEMORY
    All allocation goes through SPH_MALLOC/SPH_REALLOC/SPH_FREE. Arrays grow when particles are
@@ -288,15 +304,20 @@ extern "C" {
 /* Result of every function that can fail. The world keeps the detail in w.error. */
 typedef enum sph_status {
     SPH_OK = 0,
-    SPH_ERR_ARG,           /* an argument or a def field is invalid; nothing was changed       */
-    SPH_ERR_NOMEM,         /* an allocation failed; the world is unchanged and still usable     */
-    SPH_ERR_CAPACITY,      /* a count exceeds what the library can index (2^32-1 particles)     */
-    SPH_ERR_UNSTABLE,      /* a step produced a non-finite value or a runaway density/speed     */
-    SPH_ERR_NOT_CONVERGED, /* an iterative solver reached its iteration limit                   */
+    SPH_ERR_ARG,           /* an argument or a def field is invalid; nothing was changed (but
+                              see sph_boundary_fn)                                            */
+    SPH_ERR_NOMEM,         /* an allocation failed; the world is still valid and usable         */
+    SPH_ERR_CAPACITY,      /* a count exceeds what the library can index (more than 2^32 - 2
+                              fluid or boundary particles, more than SPH_MAX_PHASES phases)   */
+    SPH_ERR_UNSTABLE,      /* a step produced a non-finite value or a runaway density/speed, or
+                              sph_advance's stable time step collapsed                        */
+    SPH_ERR_NOT_CONVERGED, /* reserved, not returned: a solver that reaches def.max_iterations
+                              finishes the step with its last pressure (see w.stats)          */
     SPH_ERR_IO,            /* a file could not be opened, written or read (errno says why)      */
     SPH_STATUS_COUNT
 } sph_status;
 
+/* A short constant English text for the status ("unknown status" for other values). */
 SPHDEF const char* sph_status_string(sph_status status);
 
 /* ============================================================================================== */
@@ -313,7 +334,8 @@ typedef enum sph_kernel_type {
     SPH_KERNEL_COUNT
 } sph_kernel_type;
 
-/* A kernel bound to a dimension and smoothing length. Plain data: copy it freely. */
+/* A kernel bound to a dimension and smoothing length. Plain data: copy it freely. Set up with
+   sph_kernel_init; the kernel functions only read it, so any number of threads may share one. */
 typedef struct sph_kernel {
     sph_kernel_type type;
     int dim;         /* 1, 2 or 3                                                       */
@@ -321,19 +343,22 @@ typedef struct sph_kernel {
     sph_real radius; /* support radius [m] = support factor (2 or 3) * h                */
     /* derived constants (read-only) */
     int form;        /* private: polynomial variant (Wendland kernels differ in 1D)       */
-    sph_real inv_h;
+    sph_real inv_h;  /* 1 / h [1/m]                                                      */
     sph_real norm_w; /* sigma_d / h^d     : W(r) = norm_w * w(r/h)                       */
     sph_real norm_g; /* sigma_d / h^(d+2) : grad W = norm_g * f(r/h) * x_ij              */
 } sph_kernel;
 
-/* Fills k for the given type, dimension (1..3) and smoothing length h > 0 [m]. */
+/* Fills k for the given type, dimension (1..3) and smoothing length h > 0 [m]. SPH_ERR_ARG (k
+   unchanged) for k NULL, an unknown type, dim outside 1..3 or h not finite and > 0. */
 SPHDEF sph_status sph_kernel_init(sph_kernel* k, sph_kernel_type type, int dim, sph_real h);
 /* Support radius in units of h: 2 (cubic, Wendland) or 3 (quintic, Gaussian). */
 SPHDEF sph_real sph_kernel_support(sph_kernel_type type);
-/* Recommended h / particle spacing for the type (used when sph_world_def.h_factor is 0). */
+/* Recommended h / particle spacing for the type (used when sph_world_def.h_factor is 0) [-]:
+   1.3 (Wendland C2, cubic), 1.2 (quintic), 1.5 (Wendland C4), 1.6 (Wendland C6), 1.0 (Gaussian). */
 SPHDEF sph_real sph_kernel_default_h_factor(sph_kernel_type type);
+/* Lower-case name ("wendland_c2", "cubic", "quintic", ...); "unknown" for an invalid type. */
 SPHDEF const char* sph_kernel_name(sph_kernel_type type);
-/* W(r) [1/m^dim] for a distance r >= 0 [m]. */
+/* W(r) [1/m^dim] for a distance r >= 0 [m] (|r| is used); 0 from k->radius on. */
 SPHDEF sph_real sph_kernel_w(const sph_kernel* k, sph_real r);
 /* dW/dr [1/m^(dim+1)]. */
 SPHDEF sph_real sph_kernel_dwdr(const sph_kernel* k, sph_real r);
@@ -346,9 +371,10 @@ SPHDEF void sph_kernel_grad(const sph_kernel* k, const sph_real* xij, sph_real* 
 
 /* Uniform cell grid for fixed-radius neighbour search over a point set. Cells are addressed
    through a dense table over the points' bounding box when that box is small, and through a
-   hash table otherwise, so a point far away costs no memory. Periodic directions wrap. */
+   hash table otherwise, so a point far away costs no memory. Periodic directions wrap.
+   The fields up to len are set by sph_grid_init; read them, do not write them. */
 typedef struct sph_grid {
-    int dim;
+    int dim;              /* 1, 2 or 3                                                        */
     sph_real cell;        /* cell edge [m]; queries may use any radius <= cell               */
     int periodic[3];      /* nonzero: direction k wraps over [lo[k], lo[k] + len[k])          */
     sph_real lo[3];       /* periodic box origin [m]                                          */
@@ -358,7 +384,7 @@ typedef struct sph_grid {
     uint32_t* order;      /* [n] the k-th point in cell order is point order[k]               */
     uint32_t* start;      /* [nbucket + 1] bucket b holds sorted positions start[b]..start[b+1]) */
     uint64_t* key;        /* [n] hash mode only: packed cell of the k-th sorted point         */
-    size_t nbucket;
+    size_t nbucket;       /* cells of the dense table, or slots of the hash table             */
     int hashed;           /* 0: dense bounding-box table, 1: hash table                       */
     /* private */
     double inv[3];        /* 1 / cell edge per direction, slightly shrunk (see sph_grid_init)  */
@@ -370,11 +396,15 @@ typedef struct sph_grid {
 
 /* Sets up an empty grid. cell_size >= the largest query radius [m]. periodic may be NULL (no
    direction periodic); lo/hi give the periodic box and are read only for periodic directions,
-   whose length must be at least 2 * cell_size. */
+   whose length must be at least 2 * cell_size. SPH_ERR_ARG for g NULL, dim outside 1..3, a
+   cell_size not finite and > 0, or a bad periodic box. Overwrites *g: free a built grid first. */
 SPHDEF sph_status sph_grid_init(sph_grid* g, int dim, sph_real cell_size, const int* periodic,
                                 const sph_real* lo, const sph_real* hi);
+/* Releases the arrays; the grid keeps its cells and may be built again. NULL is ignored. */
 SPHDEF void sph_grid_free(sph_grid* g);
-/* Sorts n points x[i*dim + k] into cells (counting sort). x must stay valid for queries. */
+/* Sorts n points x[i*dim + k] into cells (counting sort). x must stay valid for queries.
+   Points may lie anywhere (periodic directions wrap them). SPH_ERR_CAPACITY beyond 2^32 - 2
+   points, SPH_ERR_NOMEM; memory is reused between builds. */
 SPHDEF sph_status sph_grid_build(sph_grid* g, const sph_real* x, size_t n);
 /* Indices of the built points within radius (< radius, radius <= cell) of point p. Writes at most
    cap indices to out and returns the total number found (compare with cap). */
@@ -384,7 +414,8 @@ SPHDEF size_t sph_grid_query(const sph_grid* g, const sph_real* x, const sph_rea
 SPHDEF void sph_grid_delta(const sph_grid* g, const sph_real* a, const sph_real* b, sph_real* d);
 
 /* Neighbour lists in compressed rows: the neighbours of query point i are
-   idx[begin[i]] .. idx[begin[i] + count[i] - 1], in a deterministic order. */
+   idx[begin[i]] .. idx[begin[i] + count[i] - 1], in a deterministic order. Zero the struct
+   before the first build (sph_neighbors nl = {0}); sph_neighbors_free zeroes it again. */
 typedef struct sph_neighbors {
     size_t n;            /* query points                                                      */
     size_t* begin;       /* [n]                                                               */
@@ -400,7 +431,8 @@ typedef struct sph_neighbors {
 
 /* Builds the lists of all grid points within radius of each query point xq[i*dim + k].
    x is the array the grid was built on. exclude_self: xq is that same point set, and a point is
-   not listed as its own neighbour. Memory is reused between builds and grows only when needed. */
+   not listed as its own neighbour. Memory is reused between builds and grows only when needed.
+   SPH_ERR_ARG for radius not in (0, g->cell] or a NULL array; SPH_ERR_NOMEM. */
 SPHDEF sph_status sph_neighbors_build(sph_neighbors* nl, const sph_grid* g, const sph_real* x,
                                       const sph_real* xq, size_t nq, sph_real radius,
                                       int exclude_self);
@@ -418,7 +450,8 @@ SPHDEF void sph_neighbors_free(sph_neighbors* nl);
    (d*d entries per point, row-major; sph_op_correction), or NULL for the uncorrected operator.
    Scalar fields are read as f[i * stride]. On a lattice B = I and the corrected and uncorrected
    operators agree; on disordered points only the corrected ones converge at second order
-   (tests/test_operators.c). Loops are parallel over points (OpenMP) and deterministic. */
+   (tests/test_operators.c). Loops are parallel over points (OpenMP) and deterministic. The
+   operators only read their inputs; an output array must not overlap any input. */
 
 /* omega_i = 1 / (W(0) + sum_j W_ij) [m^dim]: the Shepard volume (seed 002 eq. 6). */
 SPHDEF void sph_op_volume(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
@@ -501,7 +534,8 @@ typedef enum sph_wcsph_scheme {
                                 corrected pressure gradient and divergence, coupled Laplacian
                                 viscosity, fluid density apart from the Shepard volume, RK2
                                 midpoint, iterative shifting every def.shift_every steps with
-                                Taylor-corrected fields; every direction periodic, no walls.
+                                Taylor-corrected fields. Needs every direction periodic, no walls
+                                and no summation density (else the step fails, SPH_ERR_ARG).
                                 Second order in space (tests/test_soc.c,
                                 bench/convergence.c)                                     */
 } sph_wcsph_scheme;
@@ -578,103 +612,146 @@ typedef enum sph_stage {
 struct sph_world;
 
 /* Adds body accelerations [m/s^2] of fluid particles begin..end-1 to acc[i*dim + k] (which holds
-   gravity when it is called). Called once per step from worker threads with disjoint ranges,
-   after the step's densities and pressures are known and before the pressure and viscous forces;
-   it may read the world and must write only acc[i*dim + k] for i in its range. The wall pressure
-   extrapolation sees these accelerations like gravity. */
+   gravity when it is called). Called once per force evaluation (once per step; once per RK2
+   stage with SPH_SCHEME_SECOND_ORDER) for disjoint ranges of at most 256 particles, in parallel
+   from worker threads (from the calling thread with at most 2048 fluid particles or without
+   OpenMP), after the step's densities (and, except in PCISPH and IISPH, pressures) are known and
+   before the pressure and viscous forces; w->time is the time at the start of the step. It may
+   read the world and must write only acc[i*dim + k] for i in its range; it must be safe to run
+   on several threads at once. The wall pressure extrapolation sees these accelerations like
+   gravity. */
 typedef void (*sph_force_fn)(const struct sph_world* w, size_t begin, size_t end, sph_real* acc,
                              void* user);
 
 /* Kinematic boundary motion. Called once per step, on the calling thread, before the neighbour
-   search, with the time [s] at which the step evaluates forces. It sets w->b_x and w->b_v for
-   the boundary particles it moves (identify them by w->b_body, w->b_id or the reference position
-   w->b_x0) and may set w->b_a (wall acceleration, used by the pressure extrapolation). */
+   search, with the time [s] at which the step evaluates forces (the start of the step; its middle
+   with Stormer-Verlet); not called while the world has no boundary particles. It sets w->b_x and
+   w->b_v for the boundary particles it moves (identify them by w->b_body, w->b_id or the
+   reference position w->b_x0) and may set w->b_a (wall acceleration, used by the pressure
+   extrapolation). With a callback set, walls are re-sorted every step. A non-finite b_x, b_v or
+   b_a fails the step with SPH_ERR_ARG after the callback (and a Verlet half drift) changed the
+   world. */
 typedef void (*sph_boundary_fn)(struct sph_world* w, double time, void* user);
 
 typedef struct sph_world_def {
     int dim;                   /* 1, 2 or 3 (set by sph_world_def_default)                         */
-    sph_real spacing;          /* particle spacing dx [m]; default 0.01; > 0                      */
-    sph_real h_factor;         /* h = h_factor * dx; 0 (default) = kernel's recommended value     */
+    sph_real spacing;          /* particle spacing dx [m]; default 0.01; finite, > 0              */
+    sph_real h_factor;         /* h = h_factor * dx [-]; 0 (default) = kernel's recommended value
+                                  (sph_kernel_default_h_factor); 0 or (0, 100]. w.def holds the
+                                  value used                                                     */
     sph_kernel_type kernel;    /* default SPH_KERNEL_WENDLAND_C2                                  */
-    sph_real gravity[3];       /* [m/s^2]; default (0, -9.81, 0) in 2D/3D (y is up), 0 in 1D      */
-    sph_solver solver;         /* used by sph_step / sph_advance; default SPH_SOLVER_WCSPH        */
-    sph_density density;       /* default SPH_DENSITY_CONTINUITY                                  */
+    sph_real gravity[3];       /* [m/s^2]; default (0, -9.81, 0) in 2D/3D (y is up), 0 in 1D;
+                                  finite; components beyond dim are ignored                      */
+    sph_solver solver;         /* used by sph_step / sph_advance (and sph_set_hydrostatic);
+                                  default SPH_SOLVER_WCSPH                                       */
+    sph_density density;       /* default SPH_DENSITY_CONTINUITY; IISPH always uses summation    */
     sph_pressure_grad pressure_grad; /* default SPH_PGRAD_SYMMETRIC                               */
-    sph_integrator integrator; /* default SPH_INTEGRATOR_SYMPLECTIC_EULER                         */
+    sph_integrator integrator; /* default SPH_INTEGRATOR_SYMPLECTIC_EULER; read by WCSPH and
+                                  PCISPH (IISPH and the compressible step: symplectic Euler)    */
     sph_wcsph_scheme scheme;   /* default SPH_SCHEME_STANDARD                                     */
     int shift_every;           /* SPH_SCHEME_SECOND_ORDER: shift every this many steps (seed 002:
-                                  10, the default); 0 = never                                    */
+                                  10, the default); 0 = never; >= 0                              */
     sph_pressure_clamp clamp;  /* default SPH_CLAMP_AUTO: summation density sees a deficit at a
                                   free surface, so its negative pressures would pull the surface
-                                  into the fluid (Becker & Teschner 2007 clamp them)             */
-    sph_real delta;            /* delta-SPH density diffusion coefficient; default 0.1; [0, 1]    */
-    sph_real alpha;            /* Monaghan artificial viscosity alpha; default 0.02; [0, 10]      */
-    sph_real beta;             /* Monaghan artificial viscosity beta; default 0; [0, 10]          */
+                                  into the fluid (Becker & Teschner 2007 clamp them). WCSPH and
+                                  compressible only: PCISPH and IISPH always clamp              */
+    sph_real delta;            /* delta-SPH density diffusion coefficient [-]; default 0.1;
+                                  [0, 1]. Acts in the continuity and particle density rates, not
+                                  in IISPH or the second-order scheme                            */
+    sph_real alpha;            /* Monaghan artificial viscosity alpha [-]; default 0.02; [0, 10]  */
+    sph_real beta;             /* Monaghan artificial viscosity beta [-]; default 0; [0, 10]      */
     sph_viscosity_form viscosity_form; /* laminar viscosity operator; default SPH_VISC_MORRIS    */
     sph_wall wall;             /* default SPH_WALL_FREE_SLIP                                      */
     sph_boundary_pressure boundary_pressure; /* default SPH_BP_EXTRAPOLATE                        */
     sph_boundary_volume boundary_volume;     /* default SPH_BVOL_GIVEN                            */
-    sph_real boundary_gamma;   /* Akinci volume factor gamma_1 (seed 003 eq. 27); default 1      */
-    sph_real cfl;              /* acoustic CFL number for sph_stable_dt; default 0.25; (0, 1]     */
-    sph_real cfl_viscous;      /* viscous limit dt <= cfl_viscous h^2 / nu; default 0.125         */
-    sph_real cfl_force;        /* force limit dt <= cfl_force sqrt(h / |a|); default 0.25         */
-    sph_real cfl_velocity;     /* incompressible solvers: dt <= cfl_velocity dx / |v|max; 0.4     */
-    sph_real max_dt;           /* upper bound for sph_stable_dt [s]; 0 (default) = none           */
-    /* iterative pressure solvers (IISPH) */
-    sph_real tolerance;        /* stop when the mean predicted compression <= tolerance; 0.001     */
-    int min_iterations;        /* default 2                                                       */
-    int max_iterations;        /* default 100                                                     */
-    sph_real omega;            /* relaxed Jacobi weight; default 0.5                              */
+    sph_real boundary_gamma;   /* Akinci volume factor gamma_1 (seed 003 eq. 27) [-]; default 1;
+                                  (0, 10]; used with SPH_BVOL_AKINCI only                        */
+    sph_real cfl;              /* acoustic CFL number for sph_stable_dt (WCSPH, compressible; also
+                                  PCISPH's delta-SPH speed cfl h / dt); default 0.25; (0, 1]     */
+    sph_real cfl_viscous;      /* viscous limit dt <= cfl_viscous h^2 / nu (0.8 of it for
+                                  SPH_VISC_MONAGHAN); default 0.125; (0, 1]                     */
+    sph_real cfl_force;        /* force limit dt <= cfl_force sqrt(h / |a|), |a| the largest of
+                                  the last step (|g| before the first); default 0.25; (0, 1]    */
+    sph_real cfl_velocity;     /* incompressible solvers: dt <= cfl_velocity dx / |v|max;
+                                  default 0.4; (0, 1]                                            */
+    sph_real max_dt;           /* upper bound for sph_stable_dt [s]; 0 (default) = none; >= 0     */
+    /* iterative pressure solvers (IISPH, PCISPH) */
+    sph_real tolerance;        /* stop when the mean predicted compression <= tolerance [-];
+                                  default 0.001 (sph_world_def_pcisph: 1e-4); (0, 1)             */
+    int min_iterations;        /* default 2 (sph_world_def_pcisph: 3); [0, 100000]               */
+    int max_iterations;        /* default 100; [max(1, min_iterations), 100000]. Reaching it is
+                                  not an error: the step moves with the last pressure; compare
+                                  w.stats.iterations and .solver_error                           */
+    sph_real omega;            /* IISPH's relaxed Jacobi weight [-]; default 0.5; (0, 1]          */
     sph_real warm_start;       /* iterative solvers: initial pressure = warm_start * last pressure;
-                                  0.5 (sph_world_def_pcisph: 0 for the original, 0.5 enhanced)  */
+                                  0.5 (sph_world_def_pcisph: 0 for the original, 0.5 enhanced);
+                                  [0, 1]                                                         */
     sph_real tolerance_max;    /* PCISPH: also stop only when the largest compression <= this;
-                                  0 (default) = no such condition                              */
+                                  0 (default) = no such condition; 0 or (0, 1)                  */
     sph_pcisph_factor pcisph_factor; /* default SPH_PCISPH_PROTOTYPE                             */
     sph_real pcisph_gain;      /* 1 (default): displacement dt^2 F/m of the original paper; 2: the
-                                  thesis' dt^2/2 F/m, which doubles the correction            */
+                                  thesis' dt^2/2 F/m, which doubles the correction; (0, 4]    */
     sph_real pressure_smoothing; /* PCISPH: chi of p <- chi p + (1 - chi) <p> (seed 000 sec.
                                   3.2.1); 1 (default) = off, [0, 1]                          */
     sph_real domain_lo[3];     /* [m] domain box; particles outside are counted in                */
-    sph_real domain_hi[3];     /*     w.stats.n_outside. lo == hi in a direction: unbounded there  */
-    int periodic[3];           /* nonzero: direction wraps over [domain_lo, domain_hi)            */
-    sph_real max_compression;  /* blow-up if rho/rho0 - 1 exceeds it; default 0.2; 0 = no check  */
+    sph_real domain_hi[3];     /*     w.stats.n_outside. lo == hi in a direction: unbounded there
+                                  (default 0, 0: unbounded); finite, lo <= hi                    */
+    int periodic[3];           /* nonzero: direction wraps over [domain_lo, domain_hi), which must
+                                  be at least two kernel support radii long; default 0          */
+    sph_real max_compression;  /* blow-up if rho/rho0 - 1 exceeds it [-]; default 0.2; 0 = no
+                                  check; >= 0; not applied to gas phases                         */
     sph_real max_speed;        /* blow-up if |v| exceeds it [m/s]; 0 (default) = the largest c0,
-                                  10 c0 in the compressible step                                 */
-    sph_force_fn force;        /* optional external accelerations                                 */
-    void* force_user;
-    sph_boundary_fn boundary_motion; /* optional moving boundary particles                       */
-    void* boundary_user;
+                                  10 c0 in the compressible step (no check while no c0 is set);
+                                  >= 0                                                           */
+    sph_force_fn force;        /* optional external accelerations (sph_force_fn); default NULL  */
+    void* force_user;          /* passed to force as user                                        */
+    sph_boundary_fn boundary_motion; /* optional moving boundary particles (default NULL)        */
+    void* boundary_user;       /* passed to boundary_motion as user                              */
 } sph_world_def;
 
 /* A material. Zero fields take the documented defaults, so a compound literal with only the rest
-   density is a complete phase. */
+   density is a complete phase. sph_world_add_phase checks every field (SPH_ERR_ARG names the
+   first bad one) and keeps a copy with the defaults filled in as w.phases[index]. */
 typedef struct sph_phase {
-    sph_real rest_density;   /* rho0 [kg/m^3]; required, > 0                                      */
-    sph_real viscosity;      /* kinematic viscosity nu [m^2/s]; 0 = inviscid (default)            */
-    sph_real sound_speed;    /* c0 [m/s] at rest density; 0 = automatic: 10 * max(sqrt(2 |g| H),
-                                |v|max) at the first step, H = height of the phase's particles
-                                along gravity. Required for a stiffened gas; an ideal gas's is
-                                sqrt(gamma p_b / rho0), filled in by sph_world_add_phase         */
-    sph_eos eos;             /* default SPH_EOS_TAIT                                              */
-    sph_real gamma;          /* exponent; 0 = 7 (Tait), 1.4 (ideal gas), 4.4 (stiffened gas)      */
+    sph_real rest_density;   /* rho0 [kg/m^3]; required, finite, > 0                              */
+    sph_real viscosity;      /* kinematic viscosity nu [m^2/s]; 0 = inviscid (default); >= 0      */
+    sph_real sound_speed;    /* c0 [m/s] at rest density; >= 0; 0 = automatic: 10 * max(sqrt(2
+                                |g| H), |v|max), H = the phase's extent along gravity plus dx,
+                                chosen when a step (or sph_stable_dt, sph_set_hydrostatic) first
+                                finds particles of the phase; without gravity and motion that
+                                fails (SPH_ERR_ARG) for WCSPH and the compressible step, and
+                                IISPH and PCISPH run without c0. Required (> 0) for a stiffened
+                                gas; an ideal gas's must be left 0: it is sqrt(gamma p_b / rho0),
+                                filled in by sph_world_add_phase                                 */
+    sph_eos eos;             /* default SPH_EOS_TAIT; the gas laws need sph_step_compressible    */
+    sph_real gamma;          /* exponent [-]; 0 = 7 (Tait), 1.4 (ideal gas), 4.4 (stiffened gas);
+                                0 or [1, 20], > 1 for a gas; unused by the linear law            */
     sph_real back_pressure;  /* p_b [Pa]: the pressure at rest density (the ambient pressure of a
-                                gas); default 0                                               */
-    sph_real mass;           /* particle mass [kg]; 0 = rest_density * dx^dim                     */
+                                gas); default 0; finite, >= 0 for an ideal gas, and a stiffened
+                                gas needs p_b <= rho0 c0^2 / gamma (p_inf >= 0). Particles added
+                                at rest density, and all gas particles, start at it            */
+    sph_real mass;           /* particle mass [kg]; 0 = rest_density * dx^dim (default); >= 0     */
 } sph_phase;
 
-/* Diagnostics of the last step. */
+/* Diagnostics of the last step, taken at its end (fluid particles only). */
 typedef struct sph_stats {
     double dt;                /* [s]                                                              */
-    int iterations;           /* solver iterations (1 for WCSPH)                                   */
-    double solver_error;      /* iterative solvers: mean predicted compression at the last iteration */
-    double density_error_avg; /* mean |rho/rho0 - 1| over fluid particles                          */
-    double density_error_max; /* max |rho/rho0 - 1|                                               */
-    double compression_avg;   /* mean max(rho/rho0 - 1, 0): compression only (seed 003 eq. 15)    */
-    double v_max;             /* [m/s]                                                             */
+    int iterations;           /* solver iterations (1 for WCSPH and the compressible step; with
+                                 SPH_SCHEME_SECOND_ORDER the shifting iterations of a step that
+                                 shifts)                                                         */
+    double solver_error;      /* iterative solvers: mean predicted compression at the last iteration
+                                 [-]; the other steps leave it unchanged                         */
+    double density_error_avg; /* mean |rho/rho0 - 1| over fluid particles [-]                      */
+    double density_error_max; /* max |rho/rho0 - 1| [-]                                           */
+    double compression_avg;   /* mean max(rho/rho0 - 1, 0) [-]: compression only (seed 003 eq. 15) */
+    double v_max;             /* largest fluid speed [m/s]                                         */
     double a_max;             /* largest acceleration of the step [m/s^2]                          */
     double kinetic_energy;    /* sum 1/2 m |v|^2 [J]                                               */
-    size_t pairs;             /* fluid-fluid neighbour pairs (each counted from both sides)         */
-    size_t n_outside;         /* fluid particles outside the domain box (kept, still simulated)    */
+    size_t pairs;             /* fluid-fluid neighbour pairs (each counted from both sides); with
+                                 SPH_SCHEME_SECOND_ORDER those of its lists, which reach 0.2 dx
+                                 beyond the support                                              */
+    size_t n_outside;         /* fluid particles outside the domain box in a bounded, non-periodic
+                                 direction (kept, still simulated)                               */
     double stage_time[SPH_STAGE_COUNT]; /* wall-clock seconds per stage                            */
     double step_time;         /* wall-clock seconds of the whole step                              */
 } sph_stats;
@@ -722,91 +799,113 @@ typedef struct sph__private {
 } sph__private;
 
 /* The world: a caller-owned plain struct. Read the arrays directly; positions and velocities may
-   be written between steps. Particles are reordered by cell at every step: follow a particle by
-   its id, not by its index. Array pointers change only when particles are added. */
+   be written between steps. Particles are reordered by cell at every step (the second-order
+   scheme: whenever it rebuilds its lists): follow a particle by its id, not by its index. Array
+   pointers change only when particles are added (w.e appears when a gas phase is added). Use one
+   world from one thread at a time (see THREAD SAFETY at the top). */
 typedef struct sph_world {
-    sph_world_def def;         /* validated copy of the def                                        */
-    int dim;
+    sph_world_def def;         /* validated copy of the def (h_factor resolved, unused dims 0)     */
+    int dim;                   /* 1, 2 or 3                                                        */
     sph_real dx;               /* particle spacing [m]                                             */
     sph_real h;                /* smoothing length [m]                                             */
-    sph_kernel kernel;
-    sph_phase phases[SPH_MAX_PHASES];
-    int nphase;
+    sph_kernel kernel;         /* the kernel of def.kernel at h                                    */
+    sph_phase phases[SPH_MAX_PHASES]; /* the phases as added, defaults filled in (automatic
+                                  sound speeds once chosen)                                      */
+    int nphase;                /* phases added                                                     */
     double time;               /* simulated time [s]                                               */
     uint64_t steps;            /* steps taken                                                      */
     double step_time_total;    /* wall-clock seconds spent in steps since init                     */
     double stage_time_total[SPH_STAGE_COUNT]; /* the same per stage                               */
 
     /* fluid particles, i = 0 .. n-1 */
-    size_t n, capacity;
+    size_t n, capacity;        /* particles; room in the arrays                                    */
     sph_real* x;               /* [n*dim] position [m]                                             */
     sph_real* v;               /* [n*dim] velocity [m/s]                                           */
     sph_real* rho;             /* [n] density [kg/m^3]                                             */
     sph_real* p;               /* [n] pressure [Pa]                                                */
     sph_real* m;               /* [n] mass [kg]; NULL while all particles have the same mass       */
     sph_real mass;             /* the mass of every fluid particle while m is NULL [kg]            */
-    uint32_t* id;              /* [n] stable identity                                              */
+    uint32_t* id;              /* [n] stable identity: 0, 1, 2 ... in the order of adding          */
     uint8_t* phase;            /* [n] phase index                                                  */
     sph_real* a;               /* [n*dim] acceleration of the last step [m/s^2] (scratch)          */
     sph_real* drho;            /* [n] density rate [kg/m^3/s] (scratch)                            */
     sph_real* e;               /* [n] specific internal energy [J/kg]; NULL unless a phase has a
                                   gas equation of state (then sph_step_compressible evolves it)  */
-    uint32_t next_id;
+    uint32_t next_id;          /* id of the next fluid particle added                              */
 
     /* boundary particles, b = 0 .. nb-1 */
-    size_t nb, b_capacity;
-    sph_real* b_x;             /* [nb*dim] position [m]                                            */
-    sph_real* b_v;             /* [nb*dim] velocity [m/s]                                          */
-    sph_real* b_a;             /* [nb*dim] acceleration [m/s^2] (set by the motion callback)       */
+    size_t nb, b_capacity;     /* particles; room in the arrays                                    */
+    sph_real* b_x;             /* [nb*dim] position [m]; move it from def.boundary_motion only     */
+    sph_real* b_v;             /* [nb*dim] velocity [m/s] (0 unless the motion callback sets it)   */
+    sph_real* b_a;             /* [nb*dim] acceleration [m/s^2]; 0 unless the callback sets it     */
     sph_real* b_x0;            /* [nb*dim] reference position: where the particle was added [m]    */
-    sph_real* b_vol;           /* [nb] volume [m^dim]                                              */
-    sph_real* b_p;             /* [nb] extrapolated pressure [Pa]                                  */
-    sph_real* b_rho;           /* [nb] extrapolated density relative to rest, rho_b / rho0 [-]      */
+    sph_real* b_vol;           /* [nb] volume [m^dim] (recomputed with SPH_BVOL_AKINCI)            */
+    sph_real* b_p;             /* [nb] extrapolated pressure [Pa] (0 unless SPH_BP_EXTRAPOLATE)    */
+    sph_real* b_rho;           /* [nb] extrapolated density relative to rest, rho_b / rho0 [-]
+                                  (IISPH, PCISPH: the Shepard average of the fluid's rho/rho0)    */
     sph_real* b_vw;            /* [nb*dim] no-slip wall velocity for viscous terms (scratch)       */
-    uint32_t* b_id;            /* [nb] stable identity                                             */
+    uint32_t* b_id;            /* [nb] stable identity: 0, 1, 2 ... in the order of adding         */
     uint16_t* b_body;          /* [nb] body tag given when the particle was added                  */
-    uint32_t b_next_id;
+    uint32_t b_next_id;        /* id of the next boundary particle added                           */
 
-    sph_stats stats;
-    sph_status status;         /* status of the last failing call (SPH_OK if none)                 */
+    sph_stats stats;           /* diagnostics of the last step                                     */
+    sph_status status;         /* status of the last failing call (SPH_OK if none); a step that
+                                  passes its input checks resets it, error and error_index       */
     char error[SPH_ERROR_SIZE];/* message of the last failing call                                 */
-    long error_index;          /* particle index named by the last error, -1 if none              */
+    long error_index;          /* index of the particle the last error names (fluid or boundary,
+                                  as the message says; for sph_add_* an index into the caller's
+                                  arrays), -1 if none                                            */
     sph__private priv;
 } sph_world;
 
-/* Defaults for dimension dim (1, 2 or 3); see each field's comment. */
+/* Defaults for dimension dim (1, 2 or 3); see each field's comment. dim is checked by init. */
 SPHDEF sph_world_def sph_world_def_default(int dim);
-/* Validates def (a bad field is named in w->error) and sets up an empty world. On failure w is
-   left safe to pass to sph_world_free. */
+/* Validates def (a bad field is named in w->error, SPH_ERR_ARG; the ranges are in the field
+   comments) and sets up an empty world. Overwrites *w: free a world before initialising it
+   again. On failure w is left safe to pass to sph_world_free. */
 SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def);
+/* Releases everything the world allocated and zeroes it; NULL is ignored. */
 SPHDEF void sph_world_free(sph_world* w);
-/* Adds a phase; returns its index, or -1 with the reason in w->error. */
+/* Adds a phase (see sph_phase for the checks); returns its index, or -1 with the reason in
+   w->error (SPH_ERR_ARG, SPH_ERR_CAPACITY beyond SPH_MAX_PHASES phases, SPH_ERR_NOMEM). */
 SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase);
 /* Fills the box [lo, hi] with fluid of the phase: round(extent / dx) particles per direction,
    at the spacing that fills the box exactly (dx when the extent is a whole number of spacings),
-   each with the rest density times its cell volume as mass. */
+   each with the rest density times its cell volume as mass. Particles sit at the cell centres,
+   half a spacing in from the faces, at rest. SPH_ERR_ARG for a bad phase, lo or hi NULL, not
+   finite or hi <= lo, or an extent below half a spacing; SPH_ERR_CAPACITY for a huge box. */
 SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, const sph_real* hi);
-/* Adds n fluid particles at x[i*dim + k] with velocities v (NULL = at rest), density rho0. */
+/* Adds n fluid particles at x[i*dim + k] with velocities v (NULL = at rest), density rho0, the
+   phase's mass and its back pressure. SPH_ERR_ARG (nothing added) for a bad phase, x NULL or a
+   non-finite x or v; n = 0 does nothing. */
 SPHDEF sph_status sph_add_fluid(sph_world* w, int phase, size_t n, const sph_real* x,
                                 const sph_real* v);
 /* The same with a mass m[i] [kg] and a density rho[i] [kg/m^3] per particle (either NULL: the
-   phase's mass, the rest density). Particles of a gas phase start at its back pressure (their
-   internal energy follows from the density); the Tait and linear laws give the pressure of the
-   density. New particles take indices from the old w.n up until the next step sorts them, so a
-   host may set w.e (or any state) of the particles it just added. */
+   phase's mass, the rest density; each m[i], rho[i] finite and > 0, else SPH_ERR_ARG naming the
+   particle). Particles of a gas phase start at its back pressure (their internal energy follows
+   from the density); the Tait and linear laws give the pressure of the density. New particles
+   take indices from the old w.n up until the next step sorts them, so a host may set w.e (or any
+   state) of the particles it just added. */
 SPHDEF sph_status sph_add_fluid_ex(sph_world* w, int phase, size_t n, const sph_real* x,
                                    const sph_real* v, const sph_real* m, const sph_real* rho);
 /* Adds wall particles around the box [lo, hi] (the fluid's container), `layers` deep (0 = enough
-   layers to cover the kernel support). open_faces: SPH_FACE_* bits of faces left open. Body 0. */
+   layers to cover the kernel support). open_faces: SPH_FACE_* bits of faces left open. Body 0.
+   Layers lie outside the box, dx apart across a face (the first half a spacing out) and along it
+   at sph_fill_box's spacing; each particle's volume is its cell's. layers in [0, 64] and
+   open_faces <= 63, a box as for sph_fill_box, else SPH_ERR_ARG. */
 SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_real* hi,
                                    int layers, unsigned open_faces);
-/* Adds n boundary particles at x with volumes vol [m^dim] (NULL = dx^dim) and a body tag >= 0. */
+/* Adds n boundary particles at x with volumes vol [m^dim] (NULL = dx^dim) and a body tag in
+   [0, 65535], at rest, with b_x0 = x. SPH_ERR_ARG (nothing added) for x NULL, a non-finite x,
+   a vol[i] not finite and > 0 or a body out of range; n = 0 does nothing. */
 SPHDEF sph_status sph_add_boundary(sph_world* w, size_t n, const sph_real* x, const sph_real* vol,
                                    int body);
-/* Sets density and pressure of all fluid particles to hydrostatic equilibrium under gravity, with
-   zero pressure at the top of each column of fluid (columns of width dx across gravity); the
-   density is the equation of state's for WCSPH and the rest density for the incompressible
-   solvers. */
+/* Sets density and pressure of all fluid particles to hydrostatic equilibrium under gravity, in
+   columns of width dx across gravity: the pressure grows downwards from the back pressure of the
+   column's top phase (0 by default) half a spacing above its top particle. The density is the
+   equation of state's when def.solver is WCSPH or compressible (a gas also gets the matching
+   w.e), and the rest density for the incompressible solvers. Also chooses automatic sound
+   speeds. Velocities are kept. SPH_ERR_ARG if gravity is zero. */
 SPHDEF sph_status sph_set_hydrostatic(sph_world* w);
 /* The message of the last error (empty if none). */
 SPHDEF const char* sph_world_error(const sph_world* w);
@@ -822,18 +921,29 @@ SPHDEF void sph_world_momentum(const sph_world* w, double* out);
 /* ============================================================================================== */
 
 /* Largest stable time step [s] for the solver from the CFL (acoustic), viscous and force limits.
-   Returns 0 and sets w->error if it cannot be determined. */
+   Returns 0 and sets w->error if it cannot be determined. The first limit is cfl h / (max c0 +
+   |v|max) for WCSPH, cfl h / max(c_i + |v_i|) over fluid particles for the compressible step,
+   cfl_velocity dx / |v|max for IISPH and PCISPH (|v|max over fluid and boundary particles); then
+   the viscous and force limits and def.max_dt (see their fields). Fills in automatic sound
+   speeds. Fails (SPH_ERR_ARG) for an unknown solver, when WCSPH or the compressible step lacks a
+   sound speed it cannot choose, when WCSPH has no sound speed at all (e.g. no particles yet), or
+   when nothing limits the step. */
 SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver);
-/* One step of the solver selected in the def. */
+/* One step of the solver selected in def.solver: sph_step_wcsph, _iisph, _pcisph or
+   _compressible. */
 SPHDEF sph_status sph_step(sph_world* w, sph_real dt);
-/* Advances by duration [s] in sub-steps of the stable time step (what a game calls per frame). */
+/* Advances by duration [s] in sub-steps of the stable time step (what a game calls per frame).
+   duration finite and >= 0. Lands exactly on the end: a remainder under two steps is split in
+   halves. Returns the first error (of sph_stable_dt or a step); SPH_ERR_UNSTABLE if the
+   stable step falls below 1e-12 duration. */
 SPHDEF sph_status sph_advance(sph_world* w, sph_real duration);
 
 /* ============================================================================================== */
 /* >>wcsph                                                                                        */
 /* ============================================================================================== */
 
-/* One weakly compressible step of dt [s]. On SPH_ERR_ARG the world is unchanged. */
+/* One weakly compressible step of dt [s] (finite, > 0) with def.scheme and def.integrator. On
+   SPH_ERR_ARG the world is unchanged (but see sph_boundary_fn). */
 SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt);
 
 /* ============================================================================================== */
@@ -845,10 +955,14 @@ SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt);
    walls without extrapolated pressure, symplectic Euler); enhanced = 1 the engineering version of
    seed 000 sec. 3.2 (continuity density with delta-SPH, pressure smoothing chi = 0.8, Adami walls
    with the Shepard wall density, Stormer-Verlet, per-particle factor and the multiphase pressure
-   gradient). Each switch remains a def field to change afterwards. */
+   gradient). Each switch remains a def field to change afterwards. Both also set solver =
+   SPH_SOLVER_PCISPH, tolerance = 1e-4, min_iterations = 3 and warm_start (0 original, 0.5
+   enhanced). def NULL is ignored. */
 SPHDEF void sph_world_def_pcisph(sph_world_def* def, int enhanced);
 /* One predictive-corrective step of dt [s]: pressures are corrected until the predicted density
-   error is below def.tolerance on average (and def.tolerance_max at most, if set). */
+   error is below def.tolerance on average (and def.tolerance_max at most, if set), after
+   def.min_iterations and at most def.max_iterations. w->stats.iterations and .solver_error
+   report the solve. */
 SPHDEF sph_status sph_step_pcisph(sph_world* w, sph_real dt);
 
 /* ============================================================================================== */
@@ -857,7 +971,8 @@ SPHDEF sph_status sph_step_pcisph(sph_world* w, sph_real dt);
 
 /* One implicit incompressible step of dt [s] (Ihmsen et al. 2014; seed 003): the pressure makes
    the predicted density rest density to def.tolerance on average. w->stats.iterations and
-   .solver_error report the solve. On SPH_ERR_ARG the world is unchanged. */
+   .solver_error report the solve. On SPH_ERR_ARG the world is unchanged (but see
+   sph_boundary_fn). */
 SPHDEF sph_status sph_step_iisph(sph_world* w, sph_real dt);
 
 /* ============================================================================================== */
@@ -870,7 +985,8 @@ SPHDEF sph_status sph_step_iisph(sph_world* w, sph_real dt);
    equation (eq. 13) and Monaghan's (1992) artificial viscosity with def.alpha, def.beta and each
    particle's own sound speed; pressure from each phase's equation of state p(rho, e). Total
    energy (kinetic + internal) is conserved to round-off without walls and body forces. On
-   SPH_ERR_ARG the world is unchanged. */
+   SPH_ERR_ARG the world is unchanged (but see sph_boundary_fn). The only step that accepts gas
+   phases. */
 SPHDEF sph_status sph_step_compressible(sph_world* w, sph_real dt);
 
 /* ============================================================================================== */
