@@ -27,7 +27,8 @@
        >>pcisph        sph_step_pcisph, sph_world_def_pcisph
        >>iisph         sph_step_iisph
        >>compressible  sph_step_compressible, sph_add_fluid_ex (gases, shocks, large density ratios)
-       >>io            sph_write_csv, sph_write_vtu, sph_write_vtu_series (ParaView), sph_write_vtk
+       >>io            sph_write_csv, sph_write_vtu, sph_write_vtu_series (ParaView), sph_write_vtk;
+                       sph_world_save / _load / _copy (checkpoints, bit-exact restart)
 
    COMPILE-TIME OPTIONS (define before including the implementation)
        SPH_FLOAT          sph_real is float instead of double
@@ -1017,6 +1018,28 @@ SPHDEF sph_status sph_write_vtu_series(const sph_world* w, const char* base, int
 /* Fluid and boundary particles as a legacy ASCII VTK unstructured grid (.vtk; 9 digits): the
    same point data as sph_write_vtu without body. Larger and lossy; kept for old readers. */
 SPHDEF sph_status sph_write_vtk(const sph_world* w, const char* path);
+
+/* Save and restore: the whole state of a world (def, phases, time, every particle array, the
+   statistics, and the second-order scheme's reusable neighbour lists), so that a run that saves,
+   restores and continues is bitwise identical to one that did not. The format is binary with a
+   versioned header (magic "SPHWORLD", format version, byte order, sizeof(sph_real) and of the
+   def, phase and stats structs) and a 64-bit FNV-1a checksum at the end: a file is read back by
+   the same version of sph.h built with the same sph_real on a machine of the same byte order;
+   anything else, a truncated file or a changed byte gives SPH_ERR_IO with the reason in
+   w->error. Callbacks are not saved: the loaders take force, force_user, boundary_motion and
+   boundary_user from `callbacks` (NULL: none). On failure a loader leaves w as after
+   sph_world_free plus the message (safe to free again, nothing leaks). */
+SPHDEF sph_status sph_world_save(const sph_world* w, const char* path);
+SPHDEF sph_status sph_world_load(sph_world* w, const char* path, const sph_world_def* callbacks);
+/* The same in memory: returns the bytes the state needs and writes them to buf when cap is at
+   least that (buf may be NULL to ask the size). */
+SPHDEF size_t sph_world_save_mem(const sph_world* w, void* buf, size_t cap);
+SPHDEF sph_status sph_world_load_mem(sph_world* w, const void* buf, size_t size,
+                                     const sph_world_def* callbacks);
+/* A deep copy of src into dst (a checkpoint: keep one before a risky step and, on
+   SPH_ERR_UNSTABLE, free the world and copy the checkpoint back to retry with a smaller dt).
+   dst must not be initialised (it is overwritten, not freed); callbacks are copied. */
+SPHDEF sph_status sph_world_copy(sph_world* dst, const sph_world* src);
 
 #ifdef __cplusplus
 }
@@ -5353,6 +5376,368 @@ SPHDEF sph_status sph_write_vtk(const sph_world* w, const char* path) {
     }
     if (ferror(f)) { fclose(f); return SPH_ERR_IO; }
     return fclose(f) == 0 ? SPH_OK : SPH_ERR_IO;
+}
+
+
+/* ---- save / restore ------------------------------------------------------------------------ */
+
+/* Where the bytes go: counted always, hashed (FNV-1a 64), copied to buf while they fit, or
+   written to f. */
+typedef struct sph__sink {
+    unsigned char* buf;
+    size_t cap, pos;
+    FILE* f;
+    uint64_t hash;
+    int err;
+} sph__sink;
+
+#define SPH__SAVE_VERSION 1u
+#define SPH__FNV_OFFSET 14695981039346656037ull
+#define SPH__FNV_PRIME 1099511628211ull
+
+static uint64_t sph__fnv(uint64_t h, const void* data, size_t n) {
+    const unsigned char* p = (const unsigned char*)data;
+    size_t i;
+    for (i = 0; i < n; ++i) h = (h ^ p[i]) * SPH__FNV_PRIME;
+    return h;
+}
+
+static void sph__put(sph__sink* o, const void* data, size_t n) {
+    if (n == 0) return;
+    o->hash = sph__fnv(o->hash, data, n);
+    if (o->f) {
+        if (fwrite(data, 1, n, o->f) != n) o->err = 1;
+    } else if (o->buf && o->pos + n <= o->cap) {
+        memcpy(o->buf + o->pos, data, n);
+    }
+    o->pos += n;
+}
+
+static void sph__put_u64(sph__sink* o, uint64_t v) { sph__put(o, &v, 8); }
+static void sph__put_u32(sph__sink* o, uint32_t v) { sph__put(o, &v, 4); }
+
+/* The second-order scheme's lists are state: kept lists decide the next steps' summation order
+   (and when the particles are sorted), so a restart must reuse them to stay bitwise identical. */
+static int sph__soc_lists_saved(const sph_world* w) {
+    return w->def.scheme == SPH_SCHEME_SECOND_ORDER && w->priv.snl_valid &&
+           w->priv.snl_sorts == w->priv.sorts && w->priv.snl.n == w->n && w->priv.soc != NULL;
+}
+
+/* Header and payload; the payload layout (after the fixed header):
+     def (callback and user pointers zeroed), nphase, phases, time, steps, timings, counters,
+     stats, every fluid array (elem size, n * elem bytes), every boundary array, then the
+     second-order lists (flag; total, xref, count, idx). The checksum follows. */
+static void sph__save(const sph_world* w, sph__sink* o) {
+    sph_world_def def = w->def;
+    sph__array arr[16];
+    const size_t n = w->n, nb = w->nb, D = (size_t)w->dim;
+    /* the array lists take a non-const world but only read the pointers here */
+    sph_world* ww = (sph_world*)(uintptr_t)w;
+    const uint32_t bom = 0x01020304u;
+    int k, na;
+    def.force = NULL;
+    def.force_user = NULL;
+    def.boundary_motion = NULL;
+    def.boundary_user = NULL;
+    o->hash = SPH__FNV_OFFSET;
+    sph__put(o, "SPHWORLD", 8);
+    sph__put_u32(o, SPH__SAVE_VERSION);
+    sph__put_u32(o, bom);
+    sph__put_u32(o, (uint32_t)sizeof(sph_real));
+    sph__put_u32(o, (uint32_t)sizeof(sph_world_def));
+    sph__put_u32(o, (uint32_t)sizeof(sph_phase));
+    sph__put_u32(o, (uint32_t)sizeof(sph_stats));
+    sph__put_u32(o, (uint32_t)SPH_MAX_PHASES);
+    sph__put_u32(o, (uint32_t)SPH_STAGE_COUNT);
+    sph__put(o, &def, sizeof def);
+    sph__put_u32(o, (uint32_t)w->nphase);
+    sph__put(o, w->phases, (size_t)w->nphase * sizeof(sph_phase));
+    sph__put(o, &w->time, sizeof w->time);
+    sph__put_u64(o, w->steps);
+    sph__put(o, &w->step_time_total, sizeof w->step_time_total);
+    sph__put(o, w->stage_time_total, sizeof w->stage_time_total);
+    sph__put_u64(o, (uint64_t)n);
+    sph__put_u64(o, (uint64_t)nb);
+    sph__put_u32(o, w->next_id);
+    sph__put_u32(o, w->b_next_id);
+    sph__put_u32(o, (uint32_t)(w->m != NULL));
+    sph__put_u32(o, (uint32_t)w->priv.have_mass);
+    sph__put(o, &w->mass, sizeof w->mass);
+    sph__put(o, &w->stats, sizeof w->stats);
+    na = sph__fluid_arrays(ww, arr);
+    sph__put_u32(o, (uint32_t)na);
+    for (k = 0; k < na; ++k) {
+        sph__put_u32(o, (uint32_t)arr[k].elem);
+        sph__put(o, *arr[k].ptr, n * arr[k].elem);
+    }
+    na = sph__boundary_arrays(ww, arr);
+    sph__put_u32(o, (uint32_t)na);
+    for (k = 0; k < na; ++k) {
+        sph__put_u32(o, (uint32_t)arr[k].elem);
+        sph__put(o, *arr[k].ptr, nb * arr[k].elem);
+    }
+    if (sph__soc_lists_saved(w)) {
+        const sph_neighbors* nl = &w->priv.snl;
+        const size_t DD = D * D;
+        /* xref is the last block of the scheme's scratch (see sph__soc) */
+        const sph_real* xref = w->priv.soc + w->capacity * (3 + 5 * D + DD);
+        size_t i;
+        sph__put_u32(o, 1);
+        sph__put_u64(o, (uint64_t)nl->total);
+        sph__put(o, xref, n * D * sizeof(sph_real));
+        sph__put(o, nl->count, n * sizeof(uint32_t));
+        for (i = 0; i < n; ++i) sph__put(o, nl->idx + nl->begin[i], nl->count[i] * sizeof(uint32_t));
+    } else {
+        sph__put_u32(o, 0);
+    }
+}
+
+SPHDEF size_t sph_world_save_mem(const sph_world* w, void* buf, size_t cap) {
+    sph__sink o;
+    uint64_t h;
+    if (!w) return 0;
+    memset(&o, 0, sizeof o);
+    sph__save(w, &o); /* size first: nothing is written unless all of it fits */
+    if (!buf || cap < o.pos + 8) return o.pos + 8;
+    memset(&o, 0, sizeof o);
+    o.buf = (unsigned char*)buf;
+    o.cap = cap;
+    sph__save(w, &o);
+    h = o.hash;
+    memcpy(o.buf + o.pos, &h, 8);
+    return o.pos + 8;
+}
+
+SPHDEF sph_status sph_world_save(const sph_world* w, const char* path) {
+    sph__sink o;
+    uint64_t h;
+    if (!w || !path) return SPH_ERR_ARG;
+    memset(&o, 0, sizeof o);
+    o.f = fopen(path, "wb");
+    if (!o.f) return SPH_ERR_IO;
+    sph__save(w, &o);
+    h = o.hash;
+    if (fwrite(&h, 1, 8, o.f) != 8) o.err = 1;
+    if (ferror(o.f)) o.err = 1;
+    if (fclose(o.f) != 0) o.err = 1;
+    return o.err ? SPH_ERR_IO : SPH_OK;
+}
+
+/* Reading: a bounds-checked cursor over the bytes. */
+typedef struct sph__src {
+    const unsigned char* p;
+    size_t size, pos;
+} sph__src;
+
+static int sph__get(sph__src* in, void* dst, size_t n) {
+    if (n > in->size - in->pos) return 0;
+    if (n) memcpy(dst, in->p + in->pos, n);
+    in->pos += n;
+    return 1;
+}
+
+static sph_status sph__load_fail(sph_world* w, sph_status s, const char* fmt, ...) {
+    char msg[SPH_ERROR_SIZE];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    sph_world_free(w);
+    return sph__fail(w, s, -1, "sph_world_load: %s", msg);
+}
+
+SPHDEF sph_status sph_world_load_mem(sph_world* w, const void* buf, size_t size,
+                                     const sph_world_def* callbacks) {
+    sph__src in;
+    sph_world_def def;
+    sph__array arr[16];
+    char magic[8];
+    uint32_t u[8], nphase, has_m, have_mass, na, soc;
+    uint64_t h, n64, nb64, steps;
+    size_t n, nb, i;
+    sph_status s;
+    int k;
+    if (!w) return SPH_ERR_ARG;
+    memset(w, 0, sizeof *w);
+    w->error_index = -1;
+    if (!buf) return sph__load_fail(w, SPH_ERR_ARG, "buffer is NULL");
+    in.p = (const unsigned char*)buf;
+    in.size = size;
+    in.pos = 0;
+    if (!sph__get(&in, magic, 8) || memcmp(magic, "SPHWORLD", 8) != 0)
+        return sph__load_fail(w, SPH_ERR_IO, "not an sph.h world file (no SPHWORLD magic)");
+    if (!sph__get(&in, u, sizeof u)) return sph__load_fail(w, SPH_ERR_IO, "truncated header");
+    if (u[0] != SPH__SAVE_VERSION)
+        return sph__load_fail(w, SPH_ERR_IO, "format version %u, this sph.h reads version %u",
+                              (unsigned)u[0], SPH__SAVE_VERSION);
+    if (u[1] != 0x01020304u)
+        return sph__load_fail(w, SPH_ERR_IO, "written on a machine of the other byte order");
+    if (u[2] != sizeof(sph_real))
+        return sph__load_fail(w, SPH_ERR_IO, "written with %u-byte reals, this build has %u (%s)",
+                              (unsigned)u[2], (unsigned)sizeof(sph_real),
+                              sizeof(sph_real) == 4 ? "SPH_FLOAT" : "double");
+    if (u[3] != sizeof(sph_world_def) || u[4] != sizeof(sph_phase) || u[5] != sizeof(sph_stats) ||
+        u[6] != SPH_MAX_PHASES || u[7] != SPH_STAGE_COUNT)
+        return sph__load_fail(w, SPH_ERR_IO, "written by a different build of sph.h (struct sizes "
+                              "or SPH_MAX_PHASES differ)");
+    if (size < 8 + sizeof u + 8) return sph__load_fail(w, SPH_ERR_IO, "truncated");
+    memcpy(&h, in.p + size - 8, 8);
+    if (sph__fnv(SPH__FNV_OFFSET, in.p, size - 8) != h)
+        return sph__load_fail(w, SPH_ERR_IO, "checksum mismatch (truncated or corrupted file)");
+    in.size = size - 8;
+    if (!sph__get(&in, &def, sizeof def)) return sph__load_fail(w, SPH_ERR_IO, "truncated def");
+    def.force = callbacks ? callbacks->force : NULL;
+    def.force_user = callbacks ? callbacks->force_user : NULL;
+    def.boundary_motion = callbacks ? callbacks->boundary_motion : NULL;
+    def.boundary_user = callbacks ? callbacks->boundary_user : NULL;
+    s = sph_world_init(w, &def); /* validates every field */
+    if (s != SPH_OK) {
+        char msg[SPH_ERROR_SIZE];
+        memcpy(msg, w->error, sizeof msg);
+        return sph__load_fail(w, s, "the saved def is invalid: %s", msg);
+    }
+    if (!sph__get(&in, &nphase, 4) || nphase > SPH_MAX_PHASES)
+        return sph__load_fail(w, SPH_ERR_IO, "bad phase count");
+    if (!sph__get(&in, w->phases, nphase * sizeof(sph_phase)))
+        return sph__load_fail(w, SPH_ERR_IO, "truncated phases");
+    w->nphase = (int)nphase;
+    for (k = 0; k < w->nphase; ++k) {
+        const sph_phase* P = &w->phases[k];
+        if (!(P->rest_density > 0) || (int)P->eos < 0 || P->eos > SPH_EOS_STIFFENED_GAS)
+            return sph__load_fail(w, SPH_ERR_IO, "phase %d is invalid", k);
+        if (P->eos == SPH_EOS_IDEAL_GAS || P->eos == SPH_EOS_STIFFENED_GAS) w->priv.has_energy = 1;
+    }
+    if (!sph__get(&in, &w->time, sizeof w->time) || !sph__get(&in, &steps, 8) ||
+        !sph__get(&in, &w->step_time_total, sizeof w->step_time_total) ||
+        !sph__get(&in, w->stage_time_total, sizeof w->stage_time_total) ||
+        !sph__get(&in, &n64, 8) || !sph__get(&in, &nb64, 8) || !sph__get(&in, &w->next_id, 4) ||
+        !sph__get(&in, &w->b_next_id, 4) || !sph__get(&in, &has_m, 4) ||
+        !sph__get(&in, &have_mass, 4) || !sph__get(&in, &w->mass, sizeof w->mass) ||
+        !sph__get(&in, &w->stats, sizeof w->stats))
+        return sph__load_fail(w, SPH_ERR_IO, "truncated state");
+    w->steps = steps;
+    w->priv.have_mass = have_mass != 0;
+    /* every array must be in the file, so the counts are bounded by its size */
+    if (n64 > in.size || nb64 > in.size) return sph__load_fail(w, SPH_ERR_IO, "bad particle count");
+    n = (size_t)n64;
+    nb = (size_t)nb64;
+    if (has_m && !sph__grow((void**)&w->m, 1, sizeof(sph_real)))
+        return sph__load_fail(w, SPH_ERR_NOMEM, "out of memory");
+    if ((s = sph__reserve(w, 0, n)) != SPH_OK || (s = sph__reserve(w, 1, nb)) != SPH_OK)
+        return sph__load_fail(w, s, "out of memory for %zu + %zu particles", n, nb);
+    for (k = 0; k < 2; ++k) {
+        const size_t count = k ? nb : n;
+        const int narr = k ? sph__boundary_arrays(w, arr) : sph__fluid_arrays(w, arr);
+        int a;
+        if (!sph__get(&in, &na, 4) || na != (uint32_t)narr)
+            return sph__load_fail(w, SPH_ERR_IO, "the %s arrays do not match this build",
+                                  k ? "boundary" : "fluid");
+        for (a = 0; a < narr; ++a) {
+            uint32_t elem;
+            if (!sph__get(&in, &elem, 4) || elem != arr[a].elem)
+                return sph__load_fail(w, SPH_ERR_IO, "array element size mismatch");
+            if (count && !sph__get(&in, *arr[a].ptr, count * elem))
+                return sph__load_fail(w, SPH_ERR_IO, "truncated particle arrays");
+        }
+    }
+    w->n = n;
+    w->nb = nb;
+    for (i = 0; i < n; ++i)
+        if (w->phase[i] >= nphase)
+            return sph__load_fail(w, SPH_ERR_IO, "particle %zu has phase %u of %u", i,
+                                  (unsigned)w->phase[i], (unsigned)nphase);
+    w->priv.b_dirty = nb > 0; /* the boundary grid (and Akinci volumes) are rebuilt */
+    if (!sph__get(&in, &soc, 4)) return sph__load_fail(w, SPH_ERR_IO, "truncated");
+    if (soc) {
+        sph_neighbors* nl = &w->priv.snl;
+        sph__soc S;
+        uint64_t total;
+        size_t off = 0;
+        if (def.scheme != SPH_SCHEME_SECOND_ORDER || !sph__get(&in, &total, 8) || total > in.size)
+            return sph__load_fail(w, SPH_ERR_IO, "bad second-order lists");
+        if ((s = sph__soc_scratch(w, &S)) != SPH_OK)
+            return sph__load_fail(w, s, "out of memory");
+        if (!sph__grow((void**)&nl->begin, n, sizeof(size_t)) ||
+            !sph__grow((void**)&nl->count, n, sizeof(uint32_t)) ||
+            !sph__grow((void**)&nl->idx, (size_t)total, sizeof(uint32_t)))
+            return sph__load_fail(w, SPH_ERR_NOMEM, "out of memory");
+        nl->cap_n = n > 0 ? n : 1;
+        nl->cap_idx = total > 0 ? (size_t)total : 1;
+        if (!sph__get(&in, S.xref, n * (size_t)w->dim * sizeof(sph_real)) ||
+            !sph__get(&in, nl->count, n * sizeof(uint32_t)))
+            return sph__load_fail(w, SPH_ERR_IO, "truncated second-order lists");
+        for (i = 0; i < n; ++i) {
+            nl->begin[i] = off;
+            off += nl->count[i];
+            if (off > total) return sph__load_fail(w, SPH_ERR_IO, "bad second-order lists");
+        }
+        if (off != total || !sph__get(&in, nl->idx, (size_t)total * sizeof(uint32_t)))
+            return sph__load_fail(w, SPH_ERR_IO, "bad second-order lists");
+        for (i = 0; i < (size_t)total; ++i)
+            if (nl->idx[i] >= n) return sph__load_fail(w, SPH_ERR_IO, "bad second-order lists");
+        nl->n = n;
+        nl->total = (size_t)total;
+        w->priv.snl_valid = 1;
+        w->priv.snl_sorts = w->priv.sorts;
+    }
+    if (in.pos != in.size) return sph__load_fail(w, SPH_ERR_IO, "%zu unread bytes", in.size - in.pos);
+    w->status = SPH_OK;
+    w->error[0] = 0;
+    return SPH_OK;
+}
+
+SPHDEF sph_status sph_world_load(sph_world* w, const char* path, const sph_world_def* callbacks) {
+    FILE* f;
+    long size;
+    void* buf;
+    sph_status s;
+    if (!w) return SPH_ERR_ARG;
+    memset(w, 0, sizeof *w);
+    w->error_index = -1;
+    if (!path) return sph__fail(w, SPH_ERR_ARG, -1, "sph_world_load: path is NULL");
+    f = fopen(path, "rb");
+    if (!f) return sph__fail(w, SPH_ERR_IO, -1, "sph_world_load: cannot open %s", path);
+    if (fseek(f, 0, SEEK_END) != 0 || (size = ftell(f)) < 0 || fseek(f, 0, SEEK_SET) != 0) {
+        fclose(f);
+        return sph__fail(w, SPH_ERR_IO, -1, "sph_world_load: cannot read %s", path);
+    }
+    buf = SPH_MALLOC(size > 0 ? (size_t)size : 1);
+    if (!buf) {
+        fclose(f);
+        return sph__fail(w, SPH_ERR_NOMEM, -1, "sph_world_load: out of memory for %ld bytes", size);
+    }
+    if (fread(buf, 1, (size_t)size, f) != (size_t)size) {
+        fclose(f);
+        SPH_FREE(buf);
+        return sph__fail(w, SPH_ERR_IO, -1, "sph_world_load: cannot read %s", path);
+    }
+    fclose(f);
+    s = sph_world_load_mem(w, buf, (size_t)size, callbacks);
+    SPH_FREE(buf);
+    return s;
+}
+
+SPHDEF sph_status sph_world_copy(sph_world* dst, const sph_world* src) {
+    size_t size;
+    void* buf;
+    sph_status s;
+    if (!dst) return SPH_ERR_ARG;
+    if (!src) {
+        memset(dst, 0, sizeof *dst);
+        dst->error_index = -1;
+        return sph__fail(dst, SPH_ERR_ARG, -1, "sph_world_copy: src is NULL");
+    }
+    size = sph_world_save_mem(src, NULL, 0);
+    buf = SPH_MALLOC(size);
+    if (!buf) {
+        memset(dst, 0, sizeof *dst);
+        dst->error_index = -1;
+        return sph__fail(dst, SPH_ERR_NOMEM, -1, "sph_world_copy: out of memory (%zu bytes)", size);
+    }
+    sph_world_save_mem(src, buf, size);
+    s = sph_world_load_mem(dst, buf, size, &src->def);
+    SPH_FREE(buf);
+    return s;
 }
 
 #endif /* SPH__IMPLEMENTATION_ONCE */

@@ -8,7 +8,7 @@
 #include <omp.h>
 #endif
 
-static const th_test* const th_tables[] = {tests_kernels, tests_grid, tests_operators, tests_world, tests_io, tests_wcsph,
+static const th_test* const th_tables[] = {tests_kernels, tests_grid, tests_operators, tests_world, tests_io, tests_save, tests_wcsph,
                                            tests_pcisph, tests_iisph, tests_compressible, tests_soc,
                                            tests_compile};
 static const th_test* const th_long_tables[] = {tests_pcisph_long, tests_iisph_long,
