@@ -7,7 +7,7 @@
    walls apply a Threshold on "kind" between 0 and 0 (kind is 1 on boundary particles).
 
    Build: cc -O2 -fopenmp -I. examples/paraview.c -o paraview -lm
-   Run:   ./paraview [2d|3d = 2d] [end time s = 1.0] [output dir = out/paraview]
+   Run:   ./paraview [output dir = out/paraview] [2d|3d = 2d] [end time s = 1.0]
    Checks: every frame written and no particle lost (fluid count constant, none outside). */
 #define SPH_IMPLEMENTATION
 #include "sph.h"
@@ -18,9 +18,9 @@
 #include <string.h>
 
 int main(int argc, char** argv) {
-    const int three_d = argc > 1 && strcmp(argv[1], "3d") == 0;
-    const double t_end = argc > 2 ? atof(argv[2]) : 1.0, frame_dt = 0.05;
-    const char* dir = argc > 3 ? argv[3] : "out/paraview";
+    const char* dir = argc > 1 ? argv[1] : "out/paraview";
+    const int three_d = argc > 2 && strcmp(argv[2], "3d") == 0;
+    const double t_end = argc > 3 ? atof(argv[3]) : 1.0, frame_dt = 0.05;
     /* 2D: the Martin & Moyce column of dambreak.c, a = 0.5 m, 25 particles across (1250);
        3D: a 0.4 x 0.8 x 0.4 m column in a 1.6 x 1.0 x 0.4 m box, dx = 0.025 m (8192). */
     sph_world_def def = sph_world_def_default(three_d ? 3 : 2);
@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
     int frame = 0;
     sph_status s;
     if (!(t_end > 0)) {
-        fprintf(stderr, "usage: %s [2d|3d] [end time > 0] [output dir]\n", argv[0]);
+        fprintf(stderr, "usage: %s [output dir] [2d|3d] [end time > 0]\n", argv[0]);
         return 2;
     }
     if (three_d) {

@@ -37,6 +37,8 @@ extern const th_test tests_soc[];
 extern const th_test tests_soc_long[];
 extern const th_test tests_io[];
 extern const th_test tests_save[];
+extern const th_test tests_reliability[];
+extern const th_test tests_reliability_long[];
 
 void th_fail(const char* file, int line, const char* fmt, ...);
 void th_note(const char* fmt, ...);

@@ -8,11 +8,12 @@
 #include <omp.h>
 #endif
 
-static const th_test* const th_tables[] = {tests_kernels, tests_grid, tests_operators, tests_world, tests_io, tests_save, tests_wcsph,
+static const th_test* const th_tables[] = {tests_kernels, tests_grid, tests_operators, tests_world, tests_io, tests_save, tests_reliability, tests_wcsph,
                                            tests_pcisph, tests_iisph, tests_compressible, tests_soc,
                                            tests_compile};
 static const th_test* const th_long_tables[] = {tests_pcisph_long, tests_iisph_long,
-                                                tests_compressible_long, tests_soc_long};
+                                                tests_compressible_long, tests_soc_long,
+                                                tests_reliability_long};
 
 static int th_failed_checks;
 static int th_skip_flag;

@@ -1,0 +1,663 @@
+/* realtime.c - an interactive 2D SPH tank for game programmers (SDL2).
+   About 10k water particles in a closed 1.6 m x 1.0 m tank: stir them with the mouse, run a wave
+   paddle, switch between the three pressure solvers while it runs. Each frame simulates at most
+   a fixed budget of wall time, so the window stays responsive; on a slow machine the water moves
+   in slow motion and the top line says by how much (simulated seconds per real second).
+
+   Build: cc -O2 -std=c99 -fopenmp -I. examples/realtime.c $(sdl2-config --cflags --libs) -lm \
+             -o build/realtime
+   Run:   ./build/realtime [--particles 10000] [--solver wcsph|pcisph|iisph] [--budget 25]
+   Check: xvfb-run -a ./build/realtime --frames 150 --screenshot out/realtime.png [--solver iisph]
+          runs scripted input (a stirring drag, a pull, the paddle) without a user, then writes
+          the last frame as a PNG and one summary line per solver; exit status 1 if a step
+          failed or a particle left the tank. Without --solver the run switches
+          WCSPH -> PCISPH -> IISPH at each third. SDL_VIDEODRIVER=offscreen or dummy also work.
+
+   Keys:  left mouse   stir: drags the water near the cursor along with the cursor's motion
+          right mouse  pull: draws the water near the cursor towards it
+          1 / 2 / 3    WCSPH / PCISPH (enhanced) / IISPH (rebuilds the world from the current
+                       particle positions and velocities)
+          P paddle on/off   R reset   Esc quit                                                    */
+#define SPH_IMPLEMENTATION
+#include "sph.h"
+#include "examples/image.h"
+
+#include <SDL.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* ---- scene (SI units) ---------------------------------------------------------------------- */
+#define TANK_W 1.6    /* tank interior [m]                                                    */
+#define TANK_H 1.0
+#define DEPTH 0.4     /* water depth at rest [m]; the particle count sets the spacing          */
+#define SOUND_SPEED 20.0 /* c0 [m/s]. sph.h's automatic 10 sqrt(2 g H) would be 28 m/s here; 20
+                            keeps density errors to a few % and makes WCSPH's step 1.4x longer */
+#define VISCOSITY 1e-5   /* kinematic viscosity [m^2/s]: ten times water, calms the surface   */
+#define MAX_DT_IMPLICIT 0.002 /* [s] step cap for PCISPH/IISPH: their iterations grow with dt */
+#define TOL_IISPH 0.01   /* mean compression 1 % (sph.h: 0.1 %): 2-3 iterations a step, not 30 */
+#define TOL_PCISPH 0.001 /* 0.1 % (preset: 0.01 %, 5x the iterations); at 1 % it blows up here */
+#define PADDLE_BODY 1    /* body tag of the paddle's boundary particles                       */
+#define PADDLE_X 1.25    /* paddle centre [m] (snapped to the particle lattice)               */
+#define PADDLE_AMP 0.1   /* stroke amplitude [m]                                              */
+#define PADDLE_PERIOD 1.4 /* [s], between the tank's first two sloshing periods (1.8 s, 1.1 s),
+                             so the waves stay bounded                                       */
+#define PADDLE_Y0 0.08   /* bottom and top of the paddle [m]: water passes underneath         */
+#define PADDLE_Y1 0.80
+#define PADDLE_RAMP 0.5  /* [s] to start or stop the paddle smoothly (no infinite acceleration) */
+#define STIR_RADIUS 0.12 /* [m] reach of the mouse force, falling off as (1 - r/R)^2           */
+#define STIR_TAU 0.05    /* [s] stir: relaxation time of the water's velocity to the cursor's  */
+#define STIR_VMAX 2.5    /* [m/s] cursor speed cap: keeps the flow well below c0              */
+#define PULL_ACC 30.0    /* [m/s^2] pull towards the cursor                                   */
+#define MAX_FRAME 0.05   /* [s] most simulated time per frame (after a stall, do not catch up) */
+#define PI 3.14159265358979
+
+/* ---- screen -------------------------------------------------------------------------------- */
+#define WIN_W 960
+#define HUD_H 76        /* text band at the top [px]                                         */
+#define NBIN 32         /* speed colours                                                     */
+#define VCOLOR 1.0      /* speed [m/s] at the top of the colour map                          */
+
+static const char* const solver_name[3] = {"WCSPH", "PCISPH (enhanced)", "IISPH"};
+static const char* const solver_arg[3] = {"wcsph", "pcisph", "iisph"};
+static const sph_solver solver_id[3] = {SPH_SOLVER_WCSPH, SPH_SOLVER_PCISPH, SPH_SOLVER_IISPH};
+
+/* Mouse state in world units. Written by the main thread between steps, read by the force
+   callback on the worker threads during a step. */
+typedef struct mouse {
+    int stir, pull;     /* buttons held                                                        */
+    double x, y;        /* cursor [m]                                                          */
+    double vx, vy;      /* cursor velocity in simulated time [m/s], capped at STIR_VMAX         */
+    double px, py;      /* cursor at the previous frame [m]                                    */
+} mouse;
+
+/* Paddle state, advanced by the boundary callback. speed ramps between 0 and 1 so starting
+   and stopping are smooth; phase is the stroke angle. */
+typedef struct paddle {
+    int on;
+    double speed, phase, t_last; /* t_last < 0: the world is new, its clock starts again */
+} paddle;
+
+typedef struct demo {
+    int particles, solver;      /* requested particle count; 0, 1, 2 = WCSPH, PCISPH, IISPH */
+    double budget;              /* simulation wall time per frame [s]                       */
+    sph_world w;
+    int have_world;
+    double goal;                /* simulated time the frames have asked for so far [s]        */
+    double dx, scale, margin;   /* particle spacing [m]; pixels per metre; border [m] around
+                                   the tank interior, the walls' depth and 1 cm              */
+    mouse m;
+    paddle pad;
+    SDL_Rect* rects;            /* drawing scratch: one rect per particle                      */
+    unsigned char* bin;         /* colour bin of each fluid particle                           */
+    size_t rects_cap;
+    char msg[SPH_ERROR_SIZE + 32]; /* last error, shown on screen for a few seconds          */
+    double msg_until;
+    int errors;
+} demo;
+
+static double now(void) { /* wall clock [s] */
+    return (double)SDL_GetPerformanceCounter() / (double)SDL_GetPerformanceFrequency();
+}
+
+/* ---- callbacks ----------------------------------------------------------------------------- */
+
+/* def.force: stir and pull near the cursor. Runs on worker threads with disjoint ranges
+   [begin, end): it reads the world and the mouse and writes only acc of its own particles. */
+static void mouse_force(const sph_world* w, size_t begin, size_t end, sph_real* acc, void* user) {
+    const mouse* m = (const mouse*)user;
+    size_t i;
+    if (!m->stir && !m->pull) return;
+    for (i = begin; i < end; ++i) {
+        const double rx = (double)w->x[2 * i] - m->x, ry = (double)w->x[2 * i + 1] - m->y;
+        const double r = sqrt(rx * rx + ry * ry);
+        double q, ax = 0, ay = 0;
+        if (r >= STIR_RADIUS) continue;
+        q = (1 - r / STIR_RADIUS) * (1 - r / STIR_RADIUS); /* falloff, 1 at the cursor */
+        if (m->stir) { /* relax the velocity to the cursor's: the water follows the drag */
+            ax += (m->vx - (double)w->v[2 * i]) / STIR_TAU;
+            ay += (m->vy - (double)w->v[2 * i + 1]) / STIR_TAU;
+        }
+        if (m->pull && r > 1e-9) { /* towards the cursor, damped so the blob does not ring */
+            ax += -PULL_ACC * rx / r - 5.0 * (double)w->v[2 * i];
+            ay += -PULL_ACC * ry / r - 5.0 * (double)w->v[2 * i + 1];
+        }
+        acc[2 * i] += (sph_real)(q * ax);
+        acc[2 * i + 1] += (sph_real)(q * ay);
+    }
+}
+
+/* def.boundary_motion: moves the paddle (body PADDLE_BODY) horizontally, x = x0 + A sin(phase),
+   with phase advancing at speed * 2 pi / T. Sets position, velocity and acceleration; the
+   tank walls (body 0) stay where they are. Called once per step on the main thread. */
+static void paddle_motion(sph_world* w, double t, void* user) {
+    paddle* p = (paddle*)user;
+    const double omega = 2 * PI / PADDLE_PERIOD;
+    const double dt = p->t_last >= 0 && t > p->t_last ? t - p->t_last : 0;
+    double ds = 0, off, vel, acc;
+    size_t b;
+    if (p->on && p->speed < 1) ds = fmin(dt / PADDLE_RAMP, 1 - p->speed);
+    if (!p->on && p->speed > 0) ds = -fmin(dt / PADDLE_RAMP, p->speed);
+    p->speed += ds;
+    p->phase += omega * p->speed * dt;
+    p->t_last = t;
+    off = PADDLE_AMP * sin(p->phase);
+    vel = PADDLE_AMP * omega * p->speed * cos(p->phase);
+    acc = -PADDLE_AMP * omega * omega * p->speed * p->speed * sin(p->phase) +
+          (dt > 0 ? PADDLE_AMP * omega * cos(p->phase) * ds / dt : 0);
+    for (b = 0; b < w->nb; ++b) {
+        if (w->b_body[b] != PADDLE_BODY) continue;
+        w->b_x[2 * b] = w->b_x0[2 * b] + (sph_real)off;
+        w->b_x[2 * b + 1] = w->b_x0[2 * b + 1];
+        w->b_v[2 * b] = (sph_real)vel;
+        w->b_v[2 * b + 1] = 0;
+        w->b_a[2 * b] = (sph_real)acc;
+        w->b_a[2 * b + 1] = 0;
+    }
+}
+
+/* ---- world --------------------------------------------------------------------------------- */
+
+/* The particle spacing [m] for about `particles` particles in a layer DEPTH deep: TANK_W is a
+   whole number *nx of spacings. */
+static double spacing(int particles, int* nx) {
+    const int n = (int)floor(TANK_W / sqrt(TANK_W * DEPTH / particles) + 0.5);
+    if (nx) *nx = n;
+    return TANK_W / n;
+}
+
+/* Builds the world for d->solver: tank walls, the paddle (4 layers, so no wall particle sees
+   water on both sides), and the water, either a fresh layer at rest around the paddle
+   (x == NULL) or n particles at x, v (a solver switch). Density and pressure start hydrostatic. */
+static sph_status build_world(demo* d, const sph_real* x, const sph_real* v, size_t n) {
+    sph_world_def def = sph_world_def_default(2);
+    sph_phase water;
+    /* lattice: nx columns across the tank, paddle columns ip-2 .. ip+1 from row j0 up, water
+       rows 0 .. ny-1 around it; ny is chosen so that at least d->particles fit */
+    int nx;
+    const double dx = spacing(d->particles, &nx);
+    const int ip = (int)floor(PADDLE_X / dx + 0.5), j0 = (int)floor(PADDLE_Y0 / dx + 0.5);
+    const int ny = (d->particles - 4 * j0 + nx - 5) / (nx - 4), npy = (int)((PADDLE_Y1 - PADDLE_Y0) / dx);
+    sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)TANK_W, (sph_real)TANK_H};
+    sph_real* pad = NULL;
+    sph_status s;
+    int phase, i, k;
+    if (d->have_world) sph_world_free(&d->w);
+    d->have_world = 0;
+    d->dx = dx;
+    def.spacing = (sph_real)dx;
+    if (solver_id[d->solver] == SPH_SOLVER_PCISPH) sph_world_def_pcisph(&def, 1); /* sets solver */
+    else def.solver = solver_id[d->solver];
+    if (def.solver != SPH_SOLVER_WCSPH) def.max_dt = (sph_real)MAX_DT_IMPLICIT;
+    if (def.solver == SPH_SOLVER_IISPH) def.tolerance = (sph_real)TOL_IISPH;
+    if (def.solver == SPH_SOLVER_PCISPH) def.tolerance = (sph_real)TOL_PCISPH;
+    /* particles beyond the centres of the first wall layer count in w.stats.n_outside */
+    def.domain_lo[0] = def.domain_lo[1] = (sph_real)(-0.5 * dx);
+    def.domain_hi[0] = (sph_real)(TANK_W + 0.5 * dx);
+    def.domain_hi[1] = (sph_real)(TANK_H + 0.5 * dx);
+    def.force = mouse_force;
+    def.force_user = &d->m;
+    def.boundary_motion = paddle_motion;
+    def.boundary_user = &d->pad;
+    d->pad.t_last = -1;
+    d->goal = 0;
+    s = sph_world_init(&d->w, &def);
+    d->have_world = 1; /* safe to free even after a failed init */
+    if (s != SPH_OK) return s;
+    memset(&water, 0, sizeof(water));
+    water.rest_density = 1000;
+    water.viscosity = (sph_real)VISCOSITY;
+    water.sound_speed = (sph_real)SOUND_SPEED;
+    phase = sph_world_add_phase(&d->w, &water);
+    if (phase < 0) return SPH_ERR_ARG;
+    if (x) {
+        s = sph_add_fluid(&d->w, phase, n, x, v);
+    } else { /* left of the paddle, right of it, and the gap beneath it */
+        sph_real a0[2], a1[2];
+        a0[0] = 0; a0[1] = 0; a1[0] = (sph_real)((ip - 2) * dx); a1[1] = (sph_real)(ny * dx);
+        s = sph_fill_box(&d->w, phase, a0, a1);
+        a0[0] = (sph_real)((ip + 2) * dx); a1[0] = (sph_real)TANK_W;
+        if (s == SPH_OK) s = sph_fill_box(&d->w, phase, a0, a1);
+        a0[0] = (sph_real)((ip - 2) * dx); a1[0] = (sph_real)((ip + 2) * dx); a1[1] = (sph_real)(j0 * dx);
+        if (s == SPH_OK) s = sph_fill_box(&d->w, phase, a0, a1);
+    }
+    if (s == SPH_OK) s = sph_add_wall_box(&d->w, lo, hi, 0, 0);
+    if (s != SPH_OK) return s;
+    pad = (sph_real*)malloc(sizeof(sph_real) * 2 * 4 * (size_t)npy);
+    if (!pad) return SPH_ERR_NOMEM;
+    for (k = 0; k < 4; ++k)
+        for (i = 0; i < npy; ++i) {
+            pad[2 * (k * npy + i)] = (sph_real)((ip - 1.5 + k) * dx);
+            pad[2 * (k * npy + i) + 1] = (sph_real)((j0 + i + 0.5) * dx);
+        }
+    s = sph_add_boundary(&d->w, 4 * (size_t)npy, pad, NULL, PADDLE_BODY);
+    free(pad);
+    if (s == SPH_OK) s = sph_set_hydrostatic(&d->w);
+    if (s == SPH_OK && d->rects_cap < d->w.n + d->w.nb) { /* drawing scratch */
+        free(d->rects);
+        free(d->bin);
+        d->rects_cap = d->w.n + d->w.nb;
+        d->rects = (SDL_Rect*)malloc(sizeof(SDL_Rect) * d->rects_cap);
+        d->bin = (unsigned char*)malloc(d->rects_cap);
+        if (!d->rects || !d->bin) { d->rects_cap = 0; return SPH_ERR_NOMEM; }
+    }
+    return s;
+}
+
+/* Shows a message for 5 s (errors, resets). */
+static void say(demo* d, const char* prefix, const char* text) {
+    snprintf(d->msg, sizeof(d->msg), "%s%s", prefix, text);
+    d->msg_until = now() + 5;
+    fprintf(stderr, "realtime: %s\n", d->msg);
+}
+
+/* A fresh column: R, start, and the way out of a failed step. Returns 0 if even that fails. */
+static int reset(demo* d) {
+    d->pad.speed = 0; /* the paddle starts from rest (ramping up if on) */
+    d->pad.phase = 0;
+    if (build_world(d, NULL, NULL, 0) == SPH_OK) return 1;
+    say(d, "cannot build the scene: ", d->w.error);
+    return 0;
+}
+
+/* Keys 1/2/3: a new world with the other solver's def, from the current particles. Rebuilding
+   is simpler and safer than editing w.def: sph_world_def_pcisph changes several fields that
+   sph_world_init validates together, and each solver keeps different scratch state. */
+static int switch_solver(demo* d, int solver) {
+    const size_t n = d->w.n;
+    sph_real* xv = (sph_real*)malloc(sizeof(sph_real) * 4 * (n ? n : 1));
+    sph_status s;
+    if (solver == d->solver) { free(xv); return 1; }
+    d->solver = solver;
+    if (!xv) return reset(d);
+    memcpy(xv, d->w.x, sizeof(sph_real) * 2 * n);
+    memcpy(xv + 2 * n, d->w.v, sizeof(sph_real) * 2 * n);
+    s = build_world(d, xv, xv + 2 * n, n);
+    free(xv);
+    if (s == SPH_OK) return 1;
+    say(d, "solver switch failed, reset: ", d->w.error);
+    return reset(d);
+}
+
+/* Steps of sph_stable_dt until the simulated time reaches d->goal, or the wall-time budget is
+   spent (then the water runs in slow motion). Never shortens a step to land on the goal: a
+   sliver step makes the incompressible solvers correct their whole density error at once. */
+static sph_status simulate(demo* d, double want, int* steps) {
+    const double t0 = now();
+    double last = 0; /* wall time of the last step [s] */
+    *steps = 0;
+    if (d->goal > d->w.time + MAX_FRAME) d->goal = d->w.time + MAX_FRAME; /* drop the backlog */
+    d->goal += want;
+    for (;;) {
+        const double t1 = now();
+        sph_real dt;
+        sph_status s;
+        if (*steps > 0 && t1 - t0 + last > d->budget) break; /* at least one step per frame */
+        dt = sph_stable_dt(&d->w, d->w.def.solver);
+        if (!(dt > 0)) return d->w.status != SPH_OK ? d->w.status : SPH_ERR_UNSTABLE;
+        if (d->w.time + 0.5 * (double)dt > d->goal) break;
+        s = sph_step(&d->w, dt);
+        if (s != SPH_OK) return s;
+        ++*steps;
+        last = now() - t1;
+    }
+    return SPH_OK;
+}
+
+/* Fluid particles that left the tank: past the centres of the first wall layer (half a
+   spacing outside the interior; the fluid's outer particles touch the walls' inner face).
+   sph.h counts the same (def.domain); this also catches a NaN position. */
+static size_t count_outside(const sph_world* w) {
+    const double e = 0.5 * (double)w->dx;
+    size_t i, out = 0;
+    for (i = 0; i < w->n; ++i) {
+        const double x = (double)w->x[2 * i], y = (double)w->x[2 * i + 1];
+        if (!(x >= -e && x <= TANK_W + e && y >= -e && y <= TANK_H + e)) ++out;
+    }
+    return out > w->stats.n_outside ? out : w->stats.n_outside;
+}
+
+/* ---- input --------------------------------------------------------------------------------- */
+
+/* Cursor velocity from its motion over the last frame's simulated time, so the water follows
+   the cursor as seen on screen even in slow motion; capped at STIR_VMAX. */
+static void mouse_update(mouse* m, double sim_dt) {
+    double vx = 0, vy = 0, sp;
+    if (sim_dt > 1e-6) { vx = (m->x - m->px) / sim_dt; vy = (m->y - m->py) / sim_dt; }
+    sp = sqrt(vx * vx + vy * vy);
+    if (sp > STIR_VMAX) { vx *= STIR_VMAX / sp; vy *= STIR_VMAX / sp; }
+    m->vx = 0.5 * (m->vx + vx); /* a little smoothing against jittery mouse events */
+    m->vy = 0.5 * (m->vy + vy);
+    m->px = m->x;
+    m->py = m->y;
+}
+
+/* Check mode: frame f of nframes. Each segment (a third when the solvers switch) plays: a stir
+   that sweeps through the water and back (u = 0.1 .. 0.6), the paddle off and on again
+   (0.55 .. 0.65), a pull (0.65 .. 0.8), and a second stir from left to right (0.85 .. 1). */
+static void script_input(demo* d, int f, int nframes, int segments) {
+    const double u = fmod((f + 0.5) * segments / (double)nframes, 1.0);
+    double s = -1; /* position along a sweep, 0 .. 1 (left .. right) */
+    d->m.stir = (u >= 0.1 && u < 0.6) || u >= 0.85;
+    d->m.pull = u >= 0.65 && u < 0.8;
+    d->pad.on = u < 0.55 || u >= 0.65;
+    if (u >= 0.1 && u < 0.6) s = (u - 0.1) / 0.25 < 1 ? (u - 0.1) / 0.25 : 2 - (u - 0.1) / 0.25;
+    if (u >= 0.85) s = (u - 0.85) / 0.15;
+    if (s >= 0) {
+        d->m.x = 0.15 + 1.3 * s;
+        d->m.y = 0.22 + 0.08 * sin(4 * PI * s);
+    } else if (d->m.pull) {
+        d->m.x = 0.6;
+        d->m.y = 0.55;
+    }
+}
+
+/* ---- drawing ------------------------------------------------------------------------------- */
+
+static void world_to_px(const demo* d, double x, double y, int* px, int* py) {
+    *px = (int)floor((x + d->margin) * d->scale);
+    *py = HUD_H + (int)floor((TANK_H + d->margin - y) * d->scale);
+}
+
+/* Walls grey, paddle dark grey, water coloured by speed: particles are sorted into NBIN colour
+   bins so the renderer gets one SDL_RenderFillRects call per colour. */
+static void draw_particles(SDL_Renderer* r, demo* d) {
+    static unsigned char colour[NBIN][3];
+    size_t count[NBIN + 1], start[NBIN + 1], i, nw = 0;
+    const int size = d->dx * d->scale > 2 ? (int)ceil(d->dx * d->scale) : 2;
+    const sph_world* w = &d->w;
+    int b;
+    if (!d->rects) return;
+    if (colour[NBIN - 1][0] == 0) /* once: the colour map of examples/image.h */
+        for (b = 0; b < NBIN; ++b) img_colormap(b / (NBIN - 1.0), colour[b]);
+    for (i = 0; i < w->nb; ++i) { /* walls first, then the paddle */
+        SDL_Rect* q;
+        if (w->b_body[i] == PADDLE_BODY) continue;
+        q = &d->rects[nw++];
+        world_to_px(d, (double)w->b_x[2 * i], (double)w->b_x[2 * i + 1], &q->x, &q->y);
+        q->x -= size / 2; q->y -= size / 2; q->w = q->h = size;
+    }
+    SDL_SetRenderDrawColor(r, 150, 150, 150, 255);
+    SDL_RenderFillRects(r, d->rects, (int)nw);
+    for (i = 0, nw = 0; i < w->nb; ++i) {
+        SDL_Rect* q;
+        if (w->b_body[i] != PADDLE_BODY) continue;
+        q = &d->rects[nw++];
+        world_to_px(d, (double)w->b_x[2 * i], (double)w->b_x[2 * i + 1], &q->x, &q->y);
+        q->x -= size / 2; q->y -= size / 2; q->w = q->h = size;
+    }
+    SDL_SetRenderDrawColor(r, 70, 70, 80, 255);
+    SDL_RenderFillRects(r, d->rects, (int)nw);
+    memset(count, 0, sizeof(count));
+    for (i = 0; i < w->n; ++i) { /* counting sort by colour */
+        const double vx = (double)w->v[2 * i], vy = (double)w->v[2 * i + 1];
+        double t = sqrt(vx * vx + vy * vy) / VCOLOR * (NBIN - 1) + 0.5;
+        d->bin[i] = (unsigned char)(t < NBIN - 1 ? t : NBIN - 1);
+        ++count[d->bin[i]];
+    }
+    for (start[0] = 0, b = 0; b < NBIN; ++b) start[b + 1] = start[b] + count[b];
+    for (i = 0; i < w->n; ++i) {
+        SDL_Rect* q = &d->rects[start[d->bin[i]]++];
+        world_to_px(d, (double)w->x[2 * i], (double)w->x[2 * i + 1], &q->x, &q->y);
+        q->x -= size / 2; q->y -= size / 2; q->w = q->h = size;
+    }
+    for (i = 0, b = 0; b < NBIN; i += count[b], ++b) {
+        if (!count[b]) continue;
+        SDL_SetRenderDrawColor(r, colour[b][0], colour[b][1], colour[b][2], 255);
+        SDL_RenderFillRects(r, d->rects + i, (int)count[b]);
+    }
+}
+
+/* The cursor's reach while a button is held: a circle of STIR_RADIUS. */
+static void draw_cursor(SDL_Renderer* r, const demo* d) {
+    SDL_Point pt[33];
+    int k;
+    if (!d->m.stir && !d->m.pull) return;
+    for (k = 0; k <= 32; ++k)
+        world_to_px(d, d->m.x + STIR_RADIUS * cos(k * PI / 16), d->m.y + STIR_RADIUS * sin(k * PI / 16),
+                    &pt[k].x, &pt[k].y);
+    if (d->m.stir) SDL_SetRenderDrawColor(r, 220, 60, 40, 255);
+    else SDL_SetRenderDrawColor(r, 40, 120, 220, 255);
+    SDL_RenderDrawLines(r, pt, 33);
+}
+
+/* The text band: drawn with examples/image.h's 5x7 font into an RGB image, uploaded into a
+   streaming texture (SDL2 has no text of its own). */
+static void draw_hud(SDL_Renderer* r, SDL_Texture* tex, img* hud, const demo* d, double sim_ms,
+                     double frame_ms, int steps, double ratio) {
+    char line[320];
+    SDL_Rect band;
+    img_fill(hud, 232, 232, 228);
+    snprintf(line, sizeof(line), "%s   %zu particles   %.2g sim s per real s", solver_name[d->solver],
+             d->w.n, ratio);
+    img_text(hud, 8, 4, 2, line, 20, 20, 30);
+    snprintf(line, sizeof(line), "sim %5.1f ms   frame %5.1f ms   %2d steps of %.2f ms", sim_ms,
+             frame_ms, steps, 1e3 * d->w.stats.dt);
+    img_text(hud, 8, 26, 2, line, 20, 20, 30);
+    snprintf(line, sizeof(line), "keys: 1 WCSPH  2 PCISPH  3 IISPH   P paddle (%s)   R reset   Esc quit"
+             "      mouse: left stir, right pull", d->pad.on ? "on" : "off");
+    img_text(hud, 8, 50, 1, line, 60, 60, 70);
+    if (d->msg[0] && now() < d->msg_until) img_text(hud, 8, 62, 1, d->msg, 200, 30, 30);
+    band.x = 0; band.y = 0; band.w = hud->w; band.h = hud->h;
+    SDL_UpdateTexture(tex, NULL, hud->rgb, 3 * hud->w);
+    SDL_RenderCopy(r, tex, NULL, &band);
+}
+
+/* ---- main ---------------------------------------------------------------------------------- */
+
+static int cmp_double(const void* a, const void* b) {
+    const double x = *(const double*)a, y = *(const double*)b;
+    return x < y ? -1 : x > y;
+}
+
+static int parse_solver(const char* s) {
+    int k;
+    for (k = 0; k < 3; ++k)
+        if (strcmp(s, solver_arg[k]) == 0) return k;
+    return -1;
+}
+
+int main(int argc, char** argv) {
+    demo d;
+    int frames = 0, fixed_solver = -1, running = 1, frame = 0, steps = 0, status = 0, a, k;
+    const char* shot = NULL;
+    SDL_Window* win = NULL;
+    SDL_Renderer* ren = NULL;
+    SDL_Texture* tex = NULL;
+    img hud;
+    double t_prev, real_dt = 1.0 / 60, sim_dt = 0, sim_ms = 0, frame_ms = 0, ratio = 0;
+    double acc_sim = 0, acc_real = 0;
+    double *ms_frame = NULL, *ms_sim = NULL; /* check mode: per frame */
+    int* seg = NULL;
+    long steps_seg[3] = {0, 0, 0};
+    double simt_seg[3] = {0, 0, 0};
+    size_t out_seg[3] = {0, 0, 0};
+    int err_seg[3] = {0, 0, 0}, frames_seg[3] = {0, 0, 0}, win_h;
+
+    memset(&d, 0, sizeof(d));
+    d.particles = 10000;
+    d.budget = 0.025;
+    d.pad.on = 1;
+    for (a = 1; a < argc; a += 2) { /* options come in pairs: --name value */
+        const char* v = a + 1 < argc ? argv[a + 1] : NULL;
+        if (strcmp(argv[a], "--particles") == 0 && v) d.particles = atoi(v);
+        else if (strcmp(argv[a], "--frames") == 0 && v) frames = atoi(v);
+        else if (strcmp(argv[a], "--screenshot") == 0 && v) shot = v;
+        else if (strcmp(argv[a], "--budget") == 0 && v) d.budget = atof(v) / 1000;
+        else if (strcmp(argv[a], "--solver") == 0 && v && parse_solver(v) >= 0) fixed_solver = parse_solver(v);
+        else {
+            fprintf(stderr, "usage: %s [--particles 100..1000000] [--solver wcsph|pcisph|iisph] "
+                            "[--budget ms] [--frames N --screenshot out.png]\n", argv[0]);
+            return 2;
+        }
+    }
+    if (d.particles < 100 || d.particles > 1000000 || frames < 0 || !(d.budget > 0)) {
+        fprintf(stderr, "realtime: --particles must be in [100, 1e6], --frames >= 0, --budget > 0\n");
+        return 2;
+    }
+    d.solver = fixed_solver >= 0 ? fixed_solver : 0;
+
+    /* SDL: a window and a renderer. A check run without a display falls back to SDL's
+       offscreen and dummy video drivers; the software renderer is the fallback everywhere and
+       the first choice in check mode (SDL_RenderReadPixels needs no GPU then). */
+    if (SDL_Init(SDL_INIT_VIDEO) != 0 && frames > 0) {
+        SDL_setenv("SDL_VIDEODRIVER", "offscreen", 1);
+        if (SDL_Init(SDL_INIT_VIDEO) != 0) {
+            SDL_setenv("SDL_VIDEODRIVER", "dummy", 1);
+            SDL_Init(SDL_INIT_VIDEO);
+        }
+    }
+    if (!SDL_WasInit(SDL_INIT_VIDEO)) {
+        fprintf(stderr, "realtime: SDL_Init: %s\n", SDL_GetError());
+        return 1;
+    }
+    d.margin = spacing(d.particles, NULL) * ceil(sph_kernel_support(SPH_KERNEL_WENDLAND_C2) *
+                                                 sph_kernel_default_h_factor(SPH_KERNEL_WENDLAND_C2)) + 0.01;
+    d.scale = WIN_W / (TANK_W + 2 * d.margin);
+    win_h = HUD_H + (int)ceil((TANK_H + 2 * d.margin) * d.scale);
+    win = SDL_CreateWindow("sph.h realtime", SDL_WINDOWPOS_CENTERED, SDL_WINDOWPOS_CENTERED, WIN_W,
+                           win_h, frames > 0 ? SDL_WINDOW_HIDDEN : 0);
+    if (win) ren = SDL_CreateRenderer(win, -1, frames > 0 ? SDL_RENDERER_SOFTWARE : 0);
+    if (win && !ren) ren = SDL_CreateRenderer(win, -1, SDL_RENDERER_SOFTWARE);
+    if (ren) tex = SDL_CreateTexture(ren, SDL_PIXELFORMAT_RGB24, SDL_TEXTUREACCESS_STREAMING, WIN_W, HUD_H);
+    if (!tex || !img_init(&hud, WIN_W, HUD_H)) {
+        fprintf(stderr, "realtime: SDL window/renderer (%s): %s\n", SDL_GetCurrentVideoDriver(),
+                SDL_GetError());
+        SDL_Quit();
+        return 1;
+    }
+    if (frames > 0) {
+        ms_frame = (double*)calloc((size_t)frames, sizeof(double));
+        ms_sim = (double*)calloc((size_t)frames, sizeof(double));
+        seg = (int*)calloc((size_t)frames, sizeof(int));
+        if (!ms_frame || !ms_sim || !seg) return 1;
+    }
+    if (!reset(&d)) running = 0, status = 1;
+    if (frames == 0) printf("realtime: %zu particles, spacing %.2f mm, %s, video %s\n", d.w.n,
+                            1e3 * d.dx, solver_name[d.solver], SDL_GetCurrentVideoDriver());
+
+    t_prev = now();
+    while (running) {
+        const double t0 = now();
+        double t1, t_sim0;
+        sph_status s;
+        SDL_Event ev;
+        real_dt = t0 - t_prev;
+        t_prev = t0;
+        /* input: events and the mouse, or the script */
+        while (SDL_PollEvent(&ev)) {
+            if (ev.type == SDL_QUIT) running = 0;
+            if (ev.type != SDL_KEYDOWN || frames > 0) continue;
+            switch (ev.key.keysym.sym) {
+            case SDLK_ESCAPE: running = 0; break;
+            case SDLK_1: case SDLK_2: case SDLK_3:
+                if (!switch_solver(&d, (int)(ev.key.keysym.sym - SDLK_1))) running = 0;
+                break;
+            case SDLK_p: d.pad.on = !d.pad.on; break;
+            case SDLK_r: if (!reset(&d)) running = 0; break;
+            default: break;
+            }
+        }
+        if (!running) break;
+        if (frames > 0) {
+            const int segments = fixed_solver >= 0 ? 1 : 3, want = fixed_solver >= 0 ? fixed_solver
+                                                                 : frame * 3 / frames;
+            if (want != d.solver && !switch_solver(&d, want)) { status = 1; break; }
+            script_input(&d, frame, frames, segments);
+        } else {
+            int mx, my;
+            const Uint32 buttons = SDL_GetMouseState(&mx, &my);
+            d.m.stir = (buttons & SDL_BUTTON(SDL_BUTTON_LEFT)) != 0;
+            d.m.pull = (buttons & SDL_BUTTON(SDL_BUTTON_RIGHT)) != 0;
+            d.m.x = fmin(fmax(mx / d.scale - d.margin, 0.0), TANK_W); /* clamped into the tank */
+            d.m.y = fmin(fmax(TANK_H + d.margin - (my - HUD_H) / d.scale, 0.0), TANK_H);
+        }
+        mouse_update(&d.m, sim_dt);
+
+        /* simulate: the real time of the last frame, within the budget */
+        t_sim0 = d.w.time;
+        t1 = now();
+        s = simulate(&d, fmin(real_dt, MAX_FRAME), &steps);
+        sim_dt = d.w.time - t_sim0;
+        sim_ms = 1e3 * (now() - t1);
+        if (frames > 0) {
+            const size_t out = count_outside(&d.w);
+            if (out > out_seg[d.solver]) out_seg[d.solver] = out;
+            steps_seg[d.solver] += steps;
+            simt_seg[d.solver] += sim_dt;
+            if (s != SPH_OK) ++err_seg[d.solver];
+        }
+        if (s != SPH_OK) { /* a demo must not crash: show why, start again */
+            char why[SPH_ERROR_SIZE + 48];
+            snprintf(why, sizeof(why), "%s (%s), reset: ", solver_arg[d.solver], sph_status_string(s));
+            say(&d, why, d.w.error);
+            ++d.errors;
+            if (!reset(&d)) { status = 1; break; }
+        }
+        acc_sim += sim_dt;
+        acc_real += real_dt;
+        if (acc_real > 0.5) { ratio = acc_sim / acc_real; acc_sim = acc_real = 0; }
+
+        /* draw */
+        SDL_SetRenderDrawColor(ren, 250, 250, 247, 255);
+        SDL_RenderClear(ren);
+        draw_particles(ren, &d);
+        draw_cursor(ren, &d);
+        draw_hud(ren, tex, &hud, &d, sim_ms, frame_ms, steps, ratio);
+        if (frames > 0 && frame == frames - 1 && shot) { /* read back before present */
+            img pic;
+            if (!img_init(&pic, WIN_W, win_h) ||
+                SDL_RenderReadPixels(ren, NULL, SDL_PIXELFORMAT_RGB24, pic.rgb, 3 * WIN_W) != 0 ||
+                img_write_png(&pic, shot) != 0) {
+                fprintf(stderr, "realtime: screenshot %s failed: %s\n", shot, SDL_GetError());
+                status = 1;
+            }
+            img_free(&pic);
+        }
+        SDL_RenderPresent(ren);
+        frame_ms = 1e3 * (now() - t0);
+        if (frames > 0) {
+            ms_frame[frame] = frame_ms;
+            ms_sim[frame] = sim_ms;
+            seg[frame] = d.solver;
+            ++frames_seg[d.solver];
+            if (++frame >= frames) running = 0;
+        } else if (frame_ms < 4) {
+            SDL_Delay(1); /* idle a little when the frame was cheap */
+        }
+    }
+
+    /* check mode: one line per solver that ran */
+    for (k = 0; k < 3 && frames > 0; ++k) {
+        double* tmp = (double*)malloc(sizeof(double) * 2 * (size_t)frames);
+        double mf, ms;
+        int n = 0, f;
+        if (!frames_seg[k] || !tmp) { free(tmp); continue; }
+        for (f = 0; f < frames; ++f)
+            if (seg[f] == k) { tmp[n] = ms_frame[f]; tmp[frames + n] = ms_sim[f]; ++n; }
+        qsort(tmp, (size_t)n, sizeof(double), cmp_double);
+        qsort(tmp + frames, (size_t)n, sizeof(double), cmp_double);
+        mf = tmp[n / 2];
+        ms = tmp[frames + n / 2];
+        free(tmp);
+        printf("realtime: %-6s particles %zu  frames %d  median %.1f ms/frame (sim %.1f ms)  "
+               "steps %ld (%.1f/frame)  simulated %.3f s  outside %zu  errors %d\n",
+               solver_arg[k], d.w.n, n, mf, ms, steps_seg[k], (double)steps_seg[k] / n, simt_seg[k],
+               out_seg[k], err_seg[k]);
+        if (out_seg[k] > 0 || err_seg[k] > 0) status = 1;
+    }
+    if (frames > 0 && shot && status == 0) printf("realtime: screenshot %s\n", shot);
+    free(ms_frame);
+    free(ms_sim);
+    free(seg);
+    free(d.rects);
+    free(d.bin);
+    if (d.have_world) sph_world_free(&d.w);
+    img_free(&hud);
+    SDL_DestroyTexture(tex);
+    SDL_DestroyRenderer(ren);
+    SDL_DestroyWindow(win);
+    SDL_Quit();
+    return status;
+}
