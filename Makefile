@@ -9,6 +9,7 @@
 #   make bench     throughput (bench/bench.c) and the Taylor-Green convergence study
 #                  (bench/convergence.c), results in bench/results/; BENCH_N=40 for a quick run
 #   make paraview  the dam break as a ParaView time series: out/paraview/dambreak.pvd
+#   make realtime  the interactive SDL2 demo (optional; needs libsdl2-dev)
 #   make install   sph.h and sph.pc (pkg-config) under PREFIX (default /usr/local); CMake users
 #                  can instead add_subdirectory() this directory (CMakeLists.txt) or install it
 
@@ -35,7 +36,8 @@ EXAMPLES = hello dambreak paraview moving_boundary external_force multiphase flo
 PREFIX  ?= /usr/local
 VTK_PYTHON ?= /usr/bin/python3
 
-.PHONY: test validate bench demo paraview examples run-examples install check check-warnings check-sanitize \
+.PHONY: test validate bench demo paraview realtime examples run-examples install check-tsan \
+        check-realtime check check-warnings check-sanitize \
         check-float check-noomp check-cpp check-png check-vtk check-integration clean
 
 test: $(B)/tests
@@ -64,6 +66,12 @@ $(B)/convergence: bench/convergence.c sph.h examples/scenes.h bench/svg.h | $(B)
 demo: $(B)/dambreak
 	./$(B)/dambreak
 
+# The interactive SDL2 demo (optional: needs libsdl2-dev; nothing else depends on it).
+realtime: | $(B)
+	@command -v sdl2-config >/dev/null 2>&1 || { echo "make realtime needs SDL2: apt-get install libsdl2-dev"; exit 1; }
+	$(CC) $(CFLAGS) $(OMP) -I. examples/realtime.c $$(sdl2-config --cflags --libs) -lm -o $(B)/realtime
+	./$(B)/realtime
+
 paraview: $(B)/paraview
 	mkdir -p out/paraview
 	./$(B)/paraview out/paraview 2d 1.0
@@ -91,7 +99,7 @@ $(B):
 
 # ---- check: the quality bar --------------------------------------------------------------------
 check: check-warnings check-sanitize check-float check-noomp check-cpp check-png check-vtk \
-       check-integration
+       check-integration check-tsan check-realtime
 
 IMPL_C = printf '\#define SPH_IMPLEMENTATION\n\#include "sph.h"\nint main(void){return 0;}\n'
 
@@ -148,6 +156,14 @@ check-vtk: | $(B)
 	./$(B)/vtk_export $(B)/vtk && ./$(B)/vtk_export_f $(B)/vtk_f
 	$(VTK_PYTHON) tests/check_vtk.py $(B)/vtk
 	$(VTK_PYTHON) tests/check_vtk.py $(B)/vtk_f
+
+# ThreadSanitizer over the OpenMP loops (clang + libomp + Archer; prints SKIP without them).
+check-tsan:
+	tests/check_tsan.sh $(B)/tsan
+
+# The SDL2 demo headless under Xvfb, a screenshot per solver (prints SKIP without SDL2/Xvfb).
+check-realtime:
+	tests/check_realtime.sh
 
 # CMake add_subdirectory / find_package, pkg-config and make install, each with a tiny consumer.
 check-integration:
