@@ -3154,6 +3154,7 @@ static sph_status sph__scratch(sph_world* w, sph_real** p, size_t count) {
 static void sph__permute(sph_world* w, const sph__array* arr, int narr, const uint32_t* order,
                          size_t n) {
     int a;
+    if (n == 0) return; /* the arrays may still be NULL (a step of an empty world): no memcpy */
     for (a = 0; a < narr; ++a) {
         const size_t e = arr[a].elem;
         uint8_t* src = (uint8_t*)*arr[a].ptr;
