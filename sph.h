@@ -1132,6 +1132,12 @@ static int sph__grow(void** ptr, size_t count, size_t elem) {
     return 1;
 }
 
+/* memcpy of a particle array that may still be NULL: a world without fluid particles has no
+   arrays, and memcpy(dst, NULL, 0) is undefined behaviour. */
+static void sph__copy(void* dst, const void* src, size_t bytes) {
+    if (bytes > 0) memcpy(dst, src, bytes);
+}
+
 static sph_status sph__fail(sph_world* w, sph_status s, long index, const char* fmt, ...) {
     va_list ap;
     va_start(ap, fmt);
@@ -4054,7 +4060,7 @@ static sph_status sph__soc_lists(sph_world* w, const sph__soc* S, int sort) {
                                 w->kernel.radius + SPH__SOC_SKIN * w->dx, 1);
     if (s != SPH_OK) return sph__fail(w, s, -1, "second-order scheme: neighbour lists: %s",
                                       sph_status_string(s));
-    memcpy(S->xref, w->x, n * D * sizeof(sph_real));
+    sph__copy(S->xref, w->x, n * D * sizeof(sph_real));
     w->priv.snl_valid = 1;
     w->priv.snl_sorts = w->priv.sorts;
     w->stats.pairs = w->priv.snl.total;
@@ -4326,9 +4332,9 @@ static sph_status sph__step_soc(sph_world* w, sph_real dt) {
     if (s != SPH_OK) return s;
     sph__ctx_init(w, &c);
     sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
-    memcpy(S.x0, w->x, n * D * sizeof(sph_real));
-    memcpy(S.v0, w->v, n * D * sizeof(sph_real));
-    memcpy(S.r0, w->rho, n * sizeof(sph_real));
+    sph__copy(S.x0, w->x, n * D * sizeof(sph_real));
+    sph__copy(S.v0, w->v, n * D * sizeof(sph_real));
+    sph__copy(S.r0, w->rho, n * sizeof(sph_real));
     /* stage 1 at t^n */
     s = sph__soc_rhs(w, &c, &S, &w->priv.sgrid, &w->priv.snl);
     if (s != SPH_OK) return s;
@@ -4493,7 +4499,7 @@ static void sph__stage_smooth_pressure(sph_world* w, const sph__ctx* c, sph_real
         }
         w->priv.pr2[i] = chi * c->p[i] + (1 - chi) * num / den;
     }
-    memcpy(w->p, w->priv.pr2, w->n * sizeof(sph_real));
+    sph__copy(w->p, w->priv.pr2, w->n * sizeof(sph_real));
 }
 
 static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
@@ -4540,7 +4546,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
     c.delta_c = w->def.cfl * w->h / dt;
     sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
     if (summation) sph__stage_density_summation(w, &c);
-    memcpy(w->priv.rho_n, w->rho, w->n * sizeof(sph_real));
+    sph__copy(w->priv.rho_n, w->rho, w->n * sizeof(sph_real));
     sph__time(w, SPH_STAGE_DENSITY, &t0);
     /* non-pressure accelerations a_np (kept in w->a) */
     sph__stage_body_force(w, &c);
@@ -4936,7 +4942,7 @@ static sph_status sph__step_compressible(sph_world* w, sph_real dt) {
     if (s != SPH_OK) return s;
     sph__stage_interact(w, &c, SPH__ACCEL, w->a);
     sph__time(w, SPH_STAGE_FORCES, &t0);
-    memcpy(w->priv.vn, w->v, w->n * D * sizeof(sph_real));
+    sph__copy(w->priv.vn, w->v, w->n * D * sizeof(sph_real));
     s = sph__integrate(w, &c, dt, 0, 0, 0); /* kick */
     if (s != SPH_OK) return s;
     if (w->e) {

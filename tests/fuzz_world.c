@@ -670,8 +670,11 @@ static void fz_steps(fz_ctx* c) {
         fz_after(what, w, s, &before, 1);
         if (s == SPH_OK) {
             fz_check_finite(what, w);
-            FZ_ASSERT(w->status == SPH_OK, "%s returned SPH_OK but w.status is %s", what,
-                      sph_status_string(w->status));
+            /* a step that passes its input checks resets w.status (sph_advance over no step
+               leaves the status of an earlier failing call) */
+            if (w->steps > before.steps)
+                FZ_ASSERT(w->status == SPH_OK, "%s returned SPH_OK but w.status is %s", what,
+                          sph_status_string(w->status));
         }
         /* the read-only queries */
         {
