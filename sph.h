@@ -927,7 +927,8 @@ SPHDEF void sph_world_momentum(const sph_world* w, double* out);
    the viscous and force limits and def.max_dt (see their fields). Fills in automatic sound
    speeds. Fails (SPH_ERR_ARG) for an unknown solver, when WCSPH or the compressible step lacks a
    sound speed it cannot choose, when WCSPH has no sound speed at all (e.g. no particles yet), or
-   when nothing limits the step. */
+   when nothing limits the step; SPH_ERR_UNSTABLE when the step rounds to 0 (e.g. |v| near the
+   largest sph_real, or a cfl factor of 1e-320). */
 SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver);
 /* One step of the solver selected in def.solver: sph_step_wcsph, _iisph, _pcisph or
    _compressible. */
@@ -5045,6 +5046,13 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
     if (dt >= 1e300) {
         sph__fail(w, SPH_ERR_ARG, -1, "sph_stable_dt: nothing limits the step (no motion, no force, "
                                       "no viscosity); choose dt yourself");
+        return 0;
+    }
+    /* valid but extreme input (a cfl factor of 1e-320, speeds near overflow) can round the step
+       to 0 in sph_real: report it instead of returning 0 with no error */
+    if (!((sph_real)dt > 0)) {
+        sph__fail(w, SPH_ERR_UNSTABLE, -1, "sph_stable_dt: the stable step (%g s) rounds to 0 in sph_real; "
+                  "check the def.cfl* factors and the speeds", dt);
         return 0;
     }
     return (sph_real)dt;
