@@ -892,7 +892,8 @@ SPHDEF sph_status sph_add_fluid_ex(sph_world* w, int phase, size_t n, const sph_
    layers to cover the kernel support). open_faces: SPH_FACE_* bits of faces left open. Body 0.
    Layers lie outside the box, dx apart across a face (the first half a spacing out) and along it
    at sph_fill_box's spacing; each particle's volume is its cell's. layers in [0, 64] and
-   open_faces <= 63, a box as for sph_fill_box, else SPH_ERR_ARG. */
+   open_faces <= 63, a box as for sph_fill_box, else SPH_ERR_ARG; SPH_ERR_CAPACITY when the box
+   with its layers spans more than 2^32 - 2 lattice points (they are enumerated). */
 SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_real* hi,
                                    int layers, unsigned open_faces);
 /* Adds n boundary particles at x with volumes vol [m^dim] (NULL = dx^dim) and a body tag in
@@ -2519,6 +2520,8 @@ SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, cons
         cnt[k] = (size_t)c;
         sp[k] = (hi[k] - lo[k]) / (sph_real)c;
         mass *= (double)sp[k] / (double)w->dx;
+        if (cnt[k] > ((size_t)UINT32_MAX - 1) / total) /* 1e7^3 would overflow size_t */
+            return sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_fill_box: too many particles");
         total *= cnt[k];
     }
     if (total + w->n > (size_t)UINT32_MAX - 1)
@@ -2625,10 +2628,16 @@ SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_r
     if (layers == 0) layers = (int)ceil((double)(w->kernel.radius / w->dx) - 1e-9);
     for (k = 0; k < dim; ++k) {
         double span = (double)((hi[k] - lo[k]) / w->dx);
-        size_t ni = (size_t)(span + 0.5), j, c = 0;
+        size_t ni, j, c = 0;
         sph_real sp;
+        /* before the conversion: a span beyond size_t (or hi - lo overflowing to inf) would make
+           it undefined */
+        if (!(span <= 1e7)) {
+            s = sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_add_wall_box: box too large");
+            goto done;
+        }
+        ni = (size_t)(span + 0.5);
         if (ni < 1) ni = 1;
-        if (span > 1e7) return sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_add_wall_box: box too large");
         sp = (hi[k] - lo[k]) / (sph_real)ni;
         cnt[k] = ni + 2 * (size_t)layers;
         coord[k] = (sph_real*)SPH_MALLOC(cnt[k] * sizeof(sph_real));
@@ -2649,6 +2658,14 @@ SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_r
             coord[k][c] = hi[k] + ((sph_real)j + SPH__R(0.5)) * w->dx;
             width[k][c] = w->dx;
             side[k][c] = 1;
+        }
+        /* the points are picked from the whole lattice of box and layers, which is allocated:
+           past the particle limit it would overflow size_t or ask for terabytes */
+        if (cnt[k] > ((size_t)UINT32_MAX - 1) / total) {
+            s = sph__fail(w, SPH_ERR_CAPACITY, -1,
+                          "sph_add_wall_box: box too large (its lattice exceeds %u points)",
+                          (unsigned)(UINT32_MAX - 1));
+            goto done;
         }
         total *= cnt[k];
     }
