@@ -31,7 +31,7 @@ REAL_FIELDS += [("force_k", -100, 100), ("omega_cb", 0, 200)]
 RANGES = dict((name, (lo, hi)) for name, lo, hi in REAL_FIELDS)
 PHASE_REALS = [("rest_density", 0, 3000), ("viscosity", 0, 0.01), ("sound_speed", 0, 100),
                ("gamma", 1, 20), ("back_pressure", -100, 1e5), ("mass", 0, 10)]
-SPECIAL = {"zero": 0, "-1": 1, "nan": 2, "inf": 3, "-inf": 4, "1e300": 5, "-1e300": 6}
+SPECIAL = {"zero": 0, "-1": 1, "nan": 2, "inf": 3, "-inf": 4, "1e300": 5, "-1e300": 6, "1e6": 16}
 
 
 def real(value, lo, hi):
@@ -39,7 +39,7 @@ def real(value, lo, hi):
     if value is None:
         return bytes(3)
     if isinstance(value, str):
-        return bytes([240 + SPECIAL[value], 0, 0])
+        return bytes([224 + SPECIAL[value], 0, 0])
     t = (value - lo) / (hi - lo)
     q = max(0, min(65535, int(round(t * 65535))))
     return bytes([128, q >> 8, q & 255])
@@ -186,6 +186,10 @@ def main():
         ops=[fill(0, (0, 0, 0), ("-1", 4, 4)), fill(3, (0, 0, 0), (4, 4, 4)),
              fill(0, (0, 0, 0), (4, 4, 4)), add_fluid(0, 4, ("nan", 0, 0))],
         steps=[step(0), step(7, 3)])
+    S["huge-boxes"] = seed(
+        defs={"dim": 1},
+        ops=[wall((0, 0, 0), ("1e6", "1e6", 2)), fill(0, (0, 0, 0), ("1e6", "1e6", "1e6")),
+             wall((0, 0, 0), ("1e300", 4, 4)), fill(0, (0, 0, 0), (4, 4, 4))])
     for name, data in S.items():
         with open(os.path.join(outdir, "seed-%s.bin" % name), "wb") as f:
             f.write(data)

@@ -25,8 +25,8 @@
      phases   1 byte count, then 3 slots of 1 + 6 x 3 bytes (see fz_phases)
      ops      1 byte count, then per op a type byte and its fields (see fz_op)
      steps    1 byte count, then per step an action byte and its fields (see fz_steps)
-   A real is [mode, hi, lo]: mode < 128 keeps the default, 128..239 maps (hi, lo) onto a range,
-   240..255 picks a special value (0, -1, NaN, +-inf, 1e300, denormals, just out of range ...). */
+   A real is [mode, hi, lo]: mode < 128 keeps the default, 128..223 maps (hi, lo) onto a range,
+   224..255 picks a special value (0, -1, NaN, +-inf, 1e300, 1e6, denormals, just out of range ...). */
 #define SPH_IMPLEMENTATION
 #include "../sph.h"
 
@@ -50,7 +50,7 @@ typedef struct fz_reader {
 static unsigned fz_u8(fz_reader* r) { return r->i < r->n ? r->p[r->i++] : 0u; }
 
 static double fz_special(unsigned s, double lo, double hi) {
-    switch (s & 15u) {
+    switch (s & 31u) {
     case 0: return 0;
     case 1: return -1;
     case 2: return NAN;
@@ -66,7 +66,23 @@ static double fz_special(unsigned s, double lo, double hi) {
     case 12: return hi + (hi - lo);
     case 13: return 3.5e38; /* beyond FLT_MAX */
     case 14: return -0.0;
-    default: return 1e-7;
+    case 15: return 1e-7;
+    case 16: return 1e6;
+    case 17: return -1e6;
+    case 18: return 1e4;
+    case 19: return 2147483648.0;
+    case 20: return 4294967297.0;
+    case 21: return 1e15;
+    case 22: return 1e-15;
+    case 23: return 1e10;
+    case 24: return 1e-3;
+    case 25: return 1e-320;
+    case 26: return 0.5 * (lo + hi);
+    case 27: return lo + 1e-12 * (hi - lo);
+    case 28: return hi - 1e-12 * (hi - lo);
+    case 29: return 1e-40; /* a float denormal */
+    case 30: return 1e-45;
+    default: return -1e-300;
     }
 }
 
@@ -74,8 +90,8 @@ static double fz_special(unsigned s, double lo, double hi) {
 static double fz_real(fz_reader* r, double def, double lo, double hi) {
     unsigned mode = fz_u8(r), a = fz_u8(r), b = fz_u8(r);
     if (mode < 128) return def;
-    if (mode < 240) return lo + (hi - lo) * (double)((a << 8) | b) / 65535.0;
-    return fz_special(mode - 240, lo, hi);
+    if (mode < 224) return lo + (hi - lo) * (double)((a << 8) | b) / 65535.0;
+    return fz_special(mode - 224, lo, hi);
 }
 
 /* An enum field of `count` values: one byte; 128 + v gives v, v == count is out of range and
