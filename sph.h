@@ -671,7 +671,8 @@ typedef struct sph_world_def {
     sph_real cfl_viscous;      /* viscous limit dt <= cfl_viscous h^2 / nu (0.8 of it for
                                   SPH_VISC_MONAGHAN); default 0.125; (0, 1]                     */
     sph_real cfl_force;        /* force limit dt <= cfl_force sqrt(h / |a|), |a| the largest of
-                                  the last step (|g| before the first); default 0.25; (0, 1]    */
+                                  the last step (|g| before the first and while there is no
+                                  fluid); default 0.25; (0, 1]                                   */
     sph_real cfl_velocity;     /* incompressible solvers: dt <= cfl_velocity dx / |v|max;
                                   default 0.4; (0, 1]                                            */
     sph_real max_dt;           /* upper bound for sph_stable_dt [s]; 0 (default) = none; >= 0     */
@@ -5027,7 +5028,10 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
         if (v2 > v2max) v2max = v2;
     }
     for (k = 0; k < D; ++k) g2 += (double)w->def.gravity[k] * (double)w->def.gravity[k];
-    amax = w->steps > 0 ? w->stats.a_max : sqrt(g2);
+    /* a step without fluid particles measures no acceleration (a_max = 0): then |g| as before
+       the first step, or sph_advance over an empty world would find nothing limiting its second
+       sub-step and fail with SPH_ERR_ARG after the first had changed the world */
+    amax = w->steps > 0 && w->n > 0 ? w->stats.a_max : sqrt(g2);
     if (solver == SPH_SOLVER_WCSPH) {
         if (!(cmax > 0)) {
             sph__fail(w, SPH_ERR_ARG, -1, "sph_stable_dt: no phase has a sound speed (add particles)");
