@@ -396,7 +396,7 @@ typedef struct sph_grid {
 
 /* Sets up an empty grid. cell_size >= the largest query radius [m]. periodic may be NULL (no
    direction periodic); lo/hi give the periodic box and are read only for periodic directions,
-   whose length must be at least 2 * cell_size. SPH_ERR_ARG for g NULL, dim outside 1..3, a
+   whose length hi - lo must be finite and at least 2 * cell_size. SPH_ERR_ARG for g NULL, dim outside 1..3, a
    cell_size not finite and > 0, or a bad periodic box. Overwrites *g: free a built grid first. */
 SPHDEF sph_status sph_grid_init(sph_grid* g, int dim, sph_real cell_size, const int* periodic,
                                 const sph_real* lo, const sph_real* hi);
@@ -1447,12 +1447,12 @@ SPHDEF sph_status sph_grid_init(sph_grid* g, int dim, sph_real cell_size, const 
             if (!lo || !hi || !sph__finite((double)lo[k]) || !sph__finite((double)hi[k]))
                 return SPH_ERR_ARG;
             len = hi[k] - lo[k];
-            if (!(len >= 2 * cell_size)) return SPH_ERR_ARG;
+            if (!(len >= 2 * cell_size) || !sph__finite((double)len)) return SPH_ERR_ARG;
             g->periodic[k] = 1;
             g->lo[k] = lo[k];
             g->len[k] = len;
-            g->ncell[k] = (int32_t)floor((double)len / (double)cell_size);
-            if (g->ncell[k] > SPH__CELL_LIM) g->ncell[k] = SPH__CELL_LIM;
+            /* clamp before the conversion: a long box has more cells than int32_t holds */
+            g->ncell[k] = (int32_t)fmin(floor((double)len / (double)cell_size), (double)SPH__CELL_LIM);
             g->inv[k] = (1.0 - 1.0 / 1073741824.0) * (double)g->ncell[k] / (double)len;
         }
     }
@@ -2173,10 +2173,11 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
         per[k] = def->periodic[k] != 0;
         lo[k] = def->domain_lo[k];
         hi[k] = def->domain_hi[k];
-        if (per[k] && !(hi[k] - lo[k] >= 2 * w->kernel.radius))
+        if (per[k] && (!(hi[k] - lo[k] >= 2 * w->kernel.radius) ||
+                       !sph__finite((double)(hi[k] - lo[k]))))
             return sph__fail(w, SPH_ERR_ARG, -1,
-                             "sph_world_def.periodic[%d]: domain length %g must be at least two "
-                             "kernel support radii (%g)",
+                             "sph_world_def.periodic[%d]: domain length %g must be finite and at "
+                             "least two kernel support radii (%g)",
                              k, (double)(hi[k] - lo[k]), (double)(2 * w->kernel.radius));
     }
     s = sph_grid_init(&w->priv.grid, def->dim, w->kernel.radius, per, lo, hi);
