@@ -4218,7 +4218,7 @@ static sph_status sph__soc_rhs(sph_world* w, const sph__ctx* c, const sph__soc* 
         for (b = 0; b < D; ++b) w->a[(size_t)i * D + b] -= S->gp[(size_t)i * D + b] * inv;
     }
     for (q = 0; q < w->nphase; ++q) if (w->phases[q].viscosity > 0) any_visc = 1;
-    if (!any_visc) return SPH_OK;
+    if (!any_visc || n == 0) return SPH_OK; /* n = 0: w->v may be NULL, w->v + a undefined */
     for (a = 0; a < D; ++a) { /* nu <Lap u_a>_i = div of the corrected gradient (coupled_bc) */
         sph__soc_grad(w, nl, w->v + a, D, S->tmp);
         sph__soc_div(w, nl, S->tmp, S->lap);
