@@ -38,7 +38,7 @@
 
 #define FZ_MAX_FLUID 2000
 #define FZ_MAX_WALL 3000
-#define FZ_PAIR_BUDGET 3e6 /* particles x neighbours per particle */
+#define FZ_PAIR_BUDGET 1.5e6 /* particles x neighbours per particle (a cube of the support) */
 
 /* ---- the byte reader -------------------------------------------------------------------------- */
 
