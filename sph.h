@@ -349,7 +349,8 @@ typedef struct sph_kernel {
 } sph_kernel;
 
 /* Fills k for the given type, dimension (1..3) and smoothing length h > 0 [m]. SPH_ERR_ARG (k
-   unchanged) for k NULL, an unknown type, dim outside 1..3 or h not finite and > 0. */
+   unchanged) for k NULL, an unknown type, dim outside 1..3, h not finite and > 0, or an h so
+   small or large that 1/h or the normalisations are not finite and > 0 in sph_real. */
 SPHDEF sph_status sph_kernel_init(sph_kernel* k, sph_kernel_type type, int dim, sph_real h);
 /* Support radius in units of h: 2 (cubic, Wendland) or 3 (quintic, Gaussian). */
 SPHDEF sph_real sph_kernel_support(sph_kernel_type type);
@@ -1325,6 +1326,12 @@ SPHDEF sph_status sph_kernel_init(sph_kernel* k, sph_kernel_type type, int dim, 
     default: return SPH_ERR_ARG;
     }
     hd = dim == 1 ? (double)h : dim == 2 ? (double)h * (double)h : (double)h * (double)h * (double)h;
+    /* an h so small (or large) that 1/h or a normalisation leaves sph_real (float: h below
+       ~1e-8 m in 3D) would give infinite or zero kernel values */
+    if (!sph__finite((double)(1 / h)) || !sph__finite((double)(sph_real)(sigma / hd)) ||
+        !sph__finite((double)(sph_real)(sigma / (hd * (double)h * (double)h))) ||
+        !((sph_real)(sigma / hd) > 0) || !((sph_real)(sigma / (hd * (double)h * (double)h)) > 0))
+        return SPH_ERR_ARG;
     k->type = type;
     k->dim = dim;
     k->h = h;
@@ -2167,7 +2174,10 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
     w->def.h_factor = hf;
     w->h = hf * def->spacing;
     s = sph_kernel_init(&w->kernel, def->kernel, def->dim, w->h);
-    if (s != SPH_OK) return sph__fail(w, s, -1, "sph_world_init: kernel setup failed");
+    if (s != SPH_OK) /* the type and dim are valid: h is out of sph_real's reach */
+        return sph__fail(w, s, -1,
+                         "sph_world_def.spacing = %g: h = %g m gives kernel constants that are "
+                         "not finite and > 0 in sph_real", (double)def->spacing, (double)w->h);
     w->priv.lattice_sum = sph__lattice_sum(&w->kernel, w->dx);
     for (k = 0; k < def->dim; ++k) {
         per[k] = def->periodic[k] != 0;
@@ -2372,6 +2382,14 @@ SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase) {
                     (double)(ph.rest_density * ph.sound_speed * ph.sound_speed / ph.gamma),
                     (double)ph.back_pressure);
     }
+    vol = (double)w->dx;
+    if (w->dim >= 2) vol *= (double)w->dx;
+    if (w->dim >= 3) vol *= (double)w->dx;
+    if (ph.mass == 0) ph.mass = (sph_real)((double)ph.rest_density * vol);
+    /* rest_density * dx^dim can leave sph_real (a denormal float density or spacing) */
+    SPH__PCHECK(sph__finite((double)ph.mass) && ph.mass > 0,
+                "sph_phase: the particle mass rest_density * dx^dim = %g is not finite and > 0 in "
+                "sph_real; set sph_phase.mass", (double)ph.rest_density * vol);
 #undef SPH__PCHECK
     if (gas && !w->priv.has_energy) { /* the internal energy array, from now on */
         size_t i;
@@ -2382,10 +2400,6 @@ SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase) {
         for (i = 0; i < w->n; ++i) w->e[i] = 0;
         w->priv.has_energy = 1;
     }
-    vol = (double)w->dx;
-    if (w->dim >= 2) vol *= (double)w->dx;
-    if (w->dim >= 3) vol *= (double)w->dx;
-    if (ph.mass == 0) ph.mass = (sph_real)((double)ph.rest_density * vol);
     w->phases[w->nphase] = ph;
     return w->nphase++;
 }
