@@ -350,7 +350,8 @@ typedef struct sph_kernel {
 } sph_kernel;
 
 /* Fills k for the given type, dimension (1..3) and smoothing length h > 0 [m]. SPH_ERR_ARG (k
-   unchanged) for k NULL, an unknown type, dim outside 1..3 or h not finite and > 0. */
+   unchanged) for k NULL, an unknown type, dim outside 1..3, h not finite and > 0, or an h so
+   small or large that 1/h or the normalisations are not finite and > 0 in sph_real. */
 SPHDEF sph_status sph_kernel_init(sph_kernel* k, sph_kernel_type type, int dim, sph_real h);
 /* Support radius in units of h: 2 (cubic, Wendland) or 3 (quintic, Gaussian). */
 SPHDEF sph_real sph_kernel_support(sph_kernel_type type);
@@ -397,7 +398,7 @@ typedef struct sph_grid {
 
 /* Sets up an empty grid. cell_size >= the largest query radius [m]. periodic may be NULL (no
    direction periodic); lo/hi give the periodic box and are read only for periodic directions,
-   whose length must be at least 2 * cell_size. SPH_ERR_ARG for g NULL, dim outside 1..3, a
+   whose length hi - lo must be finite and at least 2 * cell_size. SPH_ERR_ARG for g NULL, dim outside 1..3, a
    cell_size not finite and > 0, or a bad periodic box. Overwrites *g: free a built grid first. */
 SPHDEF sph_status sph_grid_init(sph_grid* g, int dim, sph_real cell_size, const int* periodic,
                                 const sph_real* lo, const sph_real* hi);
@@ -672,7 +673,8 @@ typedef struct sph_world_def {
     sph_real cfl_viscous;      /* viscous limit dt <= cfl_viscous h^2 / nu (0.8 of it for
                                   SPH_VISC_MONAGHAN); default 0.125; (0, 1]                     */
     sph_real cfl_force;        /* force limit dt <= cfl_force sqrt(h / |a|), |a| the largest of
-                                  the last step (|g| before the first); default 0.25; (0, 1]    */
+                                  the last step (|g| before the first and while there is no
+                                  fluid); default 0.25; (0, 1]                                   */
     sph_real cfl_velocity;     /* incompressible solvers: dt <= cfl_velocity dx / |v|max;
                                   default 0.4; (0, 1]                                            */
     sph_real max_dt;           /* upper bound for sph_stable_dt [s]; 0 (default) = none; >= 0     */
@@ -893,7 +895,8 @@ SPHDEF sph_status sph_add_fluid_ex(sph_world* w, int phase, size_t n, const sph_
    layers to cover the kernel support). open_faces: SPH_FACE_* bits of faces left open. Body 0.
    Layers lie outside the box, dx apart across a face (the first half a spacing out) and along it
    at sph_fill_box's spacing; each particle's volume is its cell's. layers in [0, 64] and
-   open_faces <= 63, a box as for sph_fill_box, else SPH_ERR_ARG. */
+   open_faces <= 63, a box as for sph_fill_box, else SPH_ERR_ARG; SPH_ERR_CAPACITY when the box
+   with its layers spans more than 2^32 - 2 lattice points (they are enumerated). */
 SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_real* hi,
                                    int layers, unsigned open_faces);
 /* Adds n boundary particles at x with volumes vol [m^dim] (NULL = dx^dim) and a body tag in
@@ -928,7 +931,8 @@ SPHDEF void sph_world_momentum(const sph_world* w, double* out);
    the viscous and force limits and def.max_dt (see their fields). Fills in automatic sound
    speeds. Fails (SPH_ERR_ARG) for an unknown solver, when WCSPH or the compressible step lacks a
    sound speed it cannot choose, when WCSPH has no sound speed at all (e.g. no particles yet), or
-   when nothing limits the step. */
+   when nothing limits the step; SPH_ERR_UNSTABLE when the step rounds to 0 (e.g. |v| near the
+   largest sph_real, or a cfl factor of 1e-320). */
 SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver);
 /* One step of the solver selected in def.solver: sph_step_wcsph, _iisph, _pcisph or
    _compressible. */
@@ -1155,6 +1159,12 @@ static int sph__grow(void** ptr, size_t count, size_t elem) {
     return 1;
 }
 
+/* memcpy of a particle array that may still be NULL: a world without fluid particles has no
+   arrays, and memcpy(dst, NULL, 0) is undefined behaviour. */
+static void sph__copy(void* dst, const void* src, size_t bytes) {
+    if (bytes > 0) memcpy(dst, src, bytes);
+}
+
 static sph_status sph__fail(sph_world* w, sph_status s, long index, const char* fmt, ...) {
     va_list ap;
     va_start(ap, fmt);
@@ -1339,6 +1349,12 @@ SPHDEF sph_status sph_kernel_init(sph_kernel* k, sph_kernel_type type, int dim, 
     default: return SPH_ERR_ARG;
     }
     hd = dim == 1 ? (double)h : dim == 2 ? (double)h * (double)h : (double)h * (double)h * (double)h;
+    /* an h so small (or large) that 1/h or a normalisation leaves sph_real (float: h below
+       ~1e-8 m in 3D) would give infinite or zero kernel values */
+    if (!sph__finite((double)(1 / h)) || !sph__finite((double)(sph_real)(sigma / hd)) ||
+        !sph__finite((double)(sph_real)(sigma / (hd * (double)h * (double)h))) ||
+        !((sph_real)(sigma / hd) > 0) || !((sph_real)(sigma / (hd * (double)h * (double)h)) > 0))
+        return SPH_ERR_ARG;
     k->type = type;
     k->dim = dim;
     k->h = h;
@@ -1461,12 +1477,12 @@ SPHDEF sph_status sph_grid_init(sph_grid* g, int dim, sph_real cell_size, const 
             if (!lo || !hi || !sph__finite((double)lo[k]) || !sph__finite((double)hi[k]))
                 return SPH_ERR_ARG;
             len = hi[k] - lo[k];
-            if (!(len >= 2 * cell_size)) return SPH_ERR_ARG;
+            if (!(len >= 2 * cell_size) || !sph__finite((double)len)) return SPH_ERR_ARG;
             g->periodic[k] = 1;
             g->lo[k] = lo[k];
             g->len[k] = len;
-            g->ncell[k] = (int32_t)floor((double)len / (double)cell_size);
-            if (g->ncell[k] > SPH__CELL_LIM) g->ncell[k] = SPH__CELL_LIM;
+            /* clamp before the conversion: a long box has more cells than int32_t holds */
+            g->ncell[k] = (int32_t)fmin(floor((double)len / (double)cell_size), (double)SPH__CELL_LIM);
             g->inv[k] = (1.0 - 1.0 / 1073741824.0) * (double)g->ncell[k] / (double)len;
         }
     }
@@ -2181,16 +2197,20 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
     w->def.h_factor = hf;
     w->h = hf * def->spacing;
     s = sph_kernel_init(&w->kernel, def->kernel, def->dim, w->h);
-    if (s != SPH_OK) return sph__fail(w, s, -1, "sph_world_init: kernel setup failed");
+    if (s != SPH_OK) /* the type and dim are valid: h is out of sph_real's reach */
+        return sph__fail(w, s, -1,
+                         "sph_world_def.spacing = %g: h = %g m gives kernel constants that are "
+                         "not finite and > 0 in sph_real", (double)def->spacing, (double)w->h);
     w->priv.lattice_sum = sph__lattice_sum(&w->kernel, w->dx);
     for (k = 0; k < def->dim; ++k) {
         per[k] = def->periodic[k] != 0;
         lo[k] = def->domain_lo[k];
         hi[k] = def->domain_hi[k];
-        if (per[k] && !(hi[k] - lo[k] >= 2 * w->kernel.radius))
+        if (per[k] && (!(hi[k] - lo[k] >= 2 * w->kernel.radius) ||
+                       !sph__finite((double)(hi[k] - lo[k]))))
             return sph__fail(w, SPH_ERR_ARG, -1,
-                             "sph_world_def.periodic[%d]: domain length %g must be at least two "
-                             "kernel support radii (%g)",
+                             "sph_world_def.periodic[%d]: domain length %g must be finite and at "
+                             "least two kernel support radii (%g)",
                              k, (double)(hi[k] - lo[k]), (double)(2 * w->kernel.radius));
     }
     s = sph_grid_init(&w->priv.grid, def->dim, w->kernel.radius, per, lo, hi);
@@ -2385,6 +2405,14 @@ SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase) {
                     (double)(ph.rest_density * ph.sound_speed * ph.sound_speed / ph.gamma),
                     (double)ph.back_pressure);
     }
+    vol = (double)w->dx;
+    if (w->dim >= 2) vol *= (double)w->dx;
+    if (w->dim >= 3) vol *= (double)w->dx;
+    if (ph.mass == 0) ph.mass = (sph_real)((double)ph.rest_density * vol);
+    /* rest_density * dx^dim can leave sph_real (a denormal float density or spacing) */
+    SPH__PCHECK(sph__finite((double)ph.mass) && ph.mass > 0,
+                "sph_phase: the particle mass rest_density * dx^dim = %g is not finite and > 0 in "
+                "sph_real; set sph_phase.mass", (double)ph.rest_density * vol);
 #undef SPH__PCHECK
     if (gas && !w->priv.has_energy) { /* the internal energy array, from now on */
         size_t i;
@@ -2395,10 +2423,6 @@ SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase) {
         for (i = 0; i < w->n; ++i) w->e[i] = 0;
         w->priv.has_energy = 1;
     }
-    vol = (double)w->dx;
-    if (w->dim >= 2) vol *= (double)w->dx;
-    if (w->dim >= 3) vol *= (double)w->dx;
-    if (ph.mass == 0) ph.mass = (sph_real)((double)ph.rest_density * vol);
     w->phases[w->nphase] = ph;
     return w->nphase++;
 }
@@ -2535,6 +2559,8 @@ SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, cons
         cnt[k] = (size_t)c;
         sp[k] = (hi[k] - lo[k]) / (sph_real)c;
         mass *= (double)sp[k] / (double)w->dx;
+        if (cnt[k] > ((size_t)UINT32_MAX - 1) / total) /* 1e7^3 would overflow size_t */
+            return sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_fill_box: too many particles");
         total *= cnt[k];
     }
     if (total + w->n > (size_t)UINT32_MAX - 1)
@@ -2641,10 +2667,16 @@ SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_r
     if (layers == 0) layers = (int)ceil((double)(w->kernel.radius / w->dx) - 1e-9);
     for (k = 0; k < dim; ++k) {
         double span = (double)((hi[k] - lo[k]) / w->dx);
-        size_t ni = (size_t)(span + 0.5), j, c = 0;
+        size_t ni, j, c = 0;
         sph_real sp;
+        /* before the conversion: a span beyond size_t (or hi - lo overflowing to inf) would make
+           it undefined */
+        if (!(span <= 1e7)) {
+            s = sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_add_wall_box: box too large");
+            goto done;
+        }
+        ni = (size_t)(span + 0.5);
         if (ni < 1) ni = 1;
-        if (span > 1e7) return sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_add_wall_box: box too large");
         sp = (hi[k] - lo[k]) / (sph_real)ni;
         cnt[k] = ni + 2 * (size_t)layers;
         coord[k] = (sph_real*)SPH_MALLOC(cnt[k] * sizeof(sph_real));
@@ -2665,6 +2697,14 @@ SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_r
             coord[k][c] = hi[k] + ((sph_real)j + SPH__R(0.5)) * w->dx;
             width[k][c] = w->dx;
             side[k][c] = 1;
+        }
+        /* the points are picked from the whole lattice of box and layers, which is allocated:
+           past the particle limit it would overflow size_t or ask for terabytes */
+        if (cnt[k] > ((size_t)UINT32_MAX - 1) / total) {
+            s = sph__fail(w, SPH_ERR_CAPACITY, -1,
+                          "sph_add_wall_box: box too large (its lattice exceeds %u points)",
+                          (unsigned)(UINT32_MAX - 1));
+            goto done;
         }
         total *= cnt[k];
     }
@@ -3177,6 +3217,7 @@ static sph_status sph__scratch(sph_world* w, sph_real** p, size_t count) {
 static void sph__permute(sph_world* w, const sph__array* arr, int narr, const uint32_t* order,
                          size_t n) {
     int a;
+    if (n == 0) return; /* the arrays may still be NULL (a step of an empty world): no memcpy */
     for (a = 0; a < narr; ++a) {
         const size_t e = arr[a].elem;
         uint8_t* src = (uint8_t*)*arr[a].ptr;
@@ -4076,7 +4117,7 @@ static sph_status sph__soc_lists(sph_world* w, const sph__soc* S, int sort) {
                                 w->kernel.radius + SPH__SOC_SKIN * w->dx, 1);
     if (s != SPH_OK) return sph__fail(w, s, -1, "second-order scheme: neighbour lists: %s",
                                       sph_status_string(s));
-    memcpy(S->xref, w->x, n * D * sizeof(sph_real));
+    sph__copy(S->xref, w->x, n * D * sizeof(sph_real));
     w->priv.snl_valid = 1;
     w->priv.snl_sorts = w->priv.sorts;
     w->stats.pairs = w->priv.snl.total;
@@ -4214,7 +4255,7 @@ static sph_status sph__soc_rhs(sph_world* w, const sph__ctx* c, const sph__soc* 
         for (b = 0; b < D; ++b) w->a[(size_t)i * D + b] -= S->gp[(size_t)i * D + b] * inv;
     }
     for (q = 0; q < w->nphase; ++q) if (w->phases[q].viscosity > 0) any_visc = 1;
-    if (!any_visc) return SPH_OK;
+    if (!any_visc || n == 0) return SPH_OK; /* n = 0: w->v may be NULL, w->v + a undefined */
     for (a = 0; a < D; ++a) { /* nu <Lap u_a>_i = div of the corrected gradient (coupled_bc) */
         sph__soc_grad(w, nl, w->v + a, D, S->tmp);
         sph__soc_div(w, nl, S->tmp, S->lap);
@@ -4348,9 +4389,9 @@ static sph_status sph__step_soc(sph_world* w, sph_real dt) {
     if (s != SPH_OK) return s;
     sph__ctx_init(w, &c);
     sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
-    memcpy(S.x0, w->x, n * D * sizeof(sph_real));
-    memcpy(S.v0, w->v, n * D * sizeof(sph_real));
-    memcpy(S.r0, w->rho, n * sizeof(sph_real));
+    sph__copy(S.x0, w->x, n * D * sizeof(sph_real));
+    sph__copy(S.v0, w->v, n * D * sizeof(sph_real));
+    sph__copy(S.r0, w->rho, n * sizeof(sph_real));
     /* stage 1 at t^n */
     s = sph__soc_rhs(w, &c, &S, &w->priv.sgrid, &w->priv.snl);
     if (s != SPH_OK) return s;
@@ -4515,7 +4556,7 @@ static void sph__stage_smooth_pressure(sph_world* w, const sph__ctx* c, sph_real
         }
         w->priv.pr2[i] = chi * c->p[i] + (1 - chi) * num / den;
     }
-    memcpy(w->p, w->priv.pr2, w->n * sizeof(sph_real));
+    sph__copy(w->p, w->priv.pr2, w->n * sizeof(sph_real));
 }
 
 static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
@@ -4562,7 +4603,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
     c.delta_c = w->def.cfl * w->h / dt;
     sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
     if (summation) sph__stage_density_summation(w, &c);
-    memcpy(w->priv.rho_n, w->rho, w->n * sizeof(sph_real));
+    sph__copy(w->priv.rho_n, w->rho, w->n * sizeof(sph_real));
     sph__time(w, SPH_STAGE_DENSITY, &t0);
     /* non-pressure accelerations a_np (kept in w->a) */
     sph__stage_body_force(w, &c);
@@ -4958,7 +4999,7 @@ static sph_status sph__step_compressible(sph_world* w, sph_real dt) {
     if (s != SPH_OK) return s;
     sph__stage_interact(w, &c, SPH__ACCEL, w->a);
     sph__time(w, SPH_STAGE_FORCES, &t0);
-    memcpy(w->priv.vn, w->v, w->n * D * sizeof(sph_real));
+    sph__copy(w->priv.vn, w->v, w->n * D * sizeof(sph_real));
     s = sph__integrate(w, &c, dt, 0, 0, 0); /* kick */
     if (s != SPH_OK) return s;
     if (w->e) {
@@ -5025,7 +5066,10 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
         if (v2 > v2max) v2max = v2;
     }
     for (k = 0; k < D; ++k) g2 += (double)w->def.gravity[k] * (double)w->def.gravity[k];
-    amax = w->steps > 0 ? w->stats.a_max : sqrt(g2);
+    /* a step without fluid particles measures no acceleration (a_max = 0): then |g| as before
+       the first step, or sph_advance over an empty world would find nothing limiting its second
+       sub-step and fail with SPH_ERR_ARG after the first had changed the world */
+    amax = w->steps > 0 && w->n > 0 ? w->stats.a_max : sqrt(g2);
     if (solver == SPH_SOLVER_WCSPH) {
         if (!(cmax > 0)) {
             sph__fail(w, SPH_ERR_ARG, -1, "sph_stable_dt: no phase has a sound speed (add particles)");
@@ -5061,6 +5105,13 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
     if (dt >= 1e300) {
         sph__fail(w, SPH_ERR_ARG, -1, "sph_stable_dt: nothing limits the step (no motion, no force, "
                                       "no viscosity); choose dt yourself");
+        return 0;
+    }
+    /* valid but extreme input (a cfl factor of 1e-320, speeds near overflow) can round the step
+       to 0 in sph_real: report it instead of returning 0 with no error */
+    if (!((sph_real)dt > 0)) {
+        sph__fail(w, SPH_ERR_UNSTABLE, -1, "sph_stable_dt: the stable step (%g s) rounds to 0 in sph_real; "
+                  "check the def.cfl* factors and the speeds", dt);
         return 0;
     }
     return (sph_real)dt;

@@ -1,0 +1,48 @@
+# tests/fuzz.mk - fuzzing targets; the Makefile includes it (uses its B and CC).
+#   make fuzz          builds the libFuzzer harness tests/fuzz_world.c with clang (ASan + UBSan)
+#                      and fuzzes for FUZZ_TIME seconds from the corpus tests/fuzz_corpus (seeds
+#                      and regressions); new inputs go to $(B)/fuzz_corpus, crashes, leaks and
+#                      timeouts to $(B)/fuzz_artifacts/. Skipped, with a message, when clang
+#                      cannot link -fsanitize=fuzzer (Debian: apt-get install clang libclang-rt-14-dev).
+#                      FUZZ_DEFS=-DSPH_FLOAT fuzzes the float build; FUZZ_ARGS passes libFuzzer flags.
+#   make fuzz-replay   runs the regression inputs and the seeds through the same harness without
+#                      libFuzzer (tests/fuzz_replay.c), built with $(CC) and ASan + UBSan, in
+#                      double and in float (SPH_FLOAT).
+# A crash found by make fuzz: fix it, then keep the input as a regression:
+#   cp $(B)/fuzz_artifacts/crash-... tests/fuzz_corpus/regressions/<what-it-was>.bin
+# and FUZZ_VERBOSE=1 $(B)/fuzz_replay <file> prints what an input does.
+
+FUZZ_CC      ?= clang
+FUZZ_TIME    ?= 60
+FUZZ_TIMEOUT ?= 25
+FUZZ_RSS     ?= 2048
+FUZZ_ARGS    ?=
+FUZZ_DEFS    ?=
+FUZZ_SAN      = -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+FUZZ_INPUTS   = $(wildcard tests/fuzz_corpus/regressions/*.bin) $(wildcard tests/fuzz_corpus/seed-*.bin)
+FUZZ_DEP      = sph.h tests/fuzz_world.c
+
+.PHONY: fuzz fuzz-replay
+
+fuzz: | $(B)
+	@if printf 'int LLVMFuzzerTestOneInput(const char* d, unsigned long n) { (void)d; (void)n; return 0; }\n' | \
+	    $(FUZZ_CC) -fsanitize=fuzzer -x c - -o $(B)/fuzz_probe >/dev/null 2>&1; then \
+	    rm -f $(B)/fuzz_probe; \
+	else \
+	    echo "make fuzz: skipped: '$(FUZZ_CC) -fsanitize=fuzzer' does not link (libFuzzer missing;"; \
+	    echo "           Debian: apt-get install clang libclang-rt-14-dev, or FUZZ_CC=clang-NN)"; \
+	    exit 0; \
+	fi; \
+	set -e; \
+	echo "$(FUZZ_CC) -g -O1 -fsanitize=fuzzer,address,undefined ... tests/fuzz_world.c -o $(B)/fuzz_world"; \
+	$(FUZZ_CC) -g -O1 -fsanitize=fuzzer $(FUZZ_SAN) $(FUZZ_DEFS) -I. tests/fuzz_world.c -lm -o $(B)/fuzz_world; \
+	mkdir -p $(B)/fuzz_corpus $(B)/fuzz_artifacts; \
+	./$(B)/fuzz_world $(B)/fuzz_corpus tests/fuzz_corpus -max_total_time=$(FUZZ_TIME) \
+	    -timeout=$(FUZZ_TIMEOUT) -rss_limit_mb=$(FUZZ_RSS) -artifact_prefix=$(B)/fuzz_artifacts/ \
+	    -print_final_stats=1 $(FUZZ_ARGS)
+
+fuzz-replay: $(FUZZ_DEP) tests/fuzz_replay.c | $(B)
+	$(CC) -g -O1 -std=c99 $(WARN) $(FUZZ_SAN) -I. tests/fuzz_world.c tests/fuzz_replay.c -o $(B)/fuzz_replay -lm
+	$(CC) -g -O1 -std=c99 $(WARN) $(FUZZ_SAN) -DSPH_FLOAT -I. tests/fuzz_world.c tests/fuzz_replay.c -o $(B)/fuzz_replay_f -lm
+	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ./$(B)/fuzz_replay $(FUZZ_INPUTS)
+	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ./$(B)/fuzz_replay_f $(FUZZ_INPUTS)
