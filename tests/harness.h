@@ -36,6 +36,7 @@ extern const th_test tests_compressible_long[];
 extern const th_test tests_soc[];
 extern const th_test tests_soc_long[];
 extern const th_test tests_io[];
+extern const th_test tests_oom[]; /* out of memory: every allocation failing once */
 
 void th_fail(const char* file, int line, const char* fmt, ...);
 void th_note(const char* fmt, ...);
