@@ -26,12 +26,12 @@ B        = build
 TEST_SRC = tests/main.c tests/impl.c tests/test_kernels.c tests/test_grid.c tests/test_operators.c \
            tests/test_world.c tests/test_wcsph.c tests/test_pcisph.c tests/test_iisph.c \
            tests/test_compressible.c tests/test_soc.c tests/test_io.c tests/test_save.c \
-           tests/test_reliability.c \
+           tests/test_reliability.c tests/test_oom.c \
            tests/test_compile.c \
            tests/compile_second.c \
            tests/compile_static.c
 TEST_CXX = tests/compile_cpp.cpp
-TEST_DEP = sph.h tests/harness.h tests/riemann.h bench/svg.h examples/scenes.h $(TEST_SRC) $(TEST_CXX)
+TEST_DEP = sph.h tests/harness.h tests/alloc.h tests/riemann.h bench/svg.h examples/scenes.h $(TEST_SRC) $(TEST_CXX)
 EXAMPLES = hello dambreak paraview moving_boundary external_force multiphase float_build
 PREFIX  ?= /usr/local
 VTK_PYTHON ?= /usr/bin/python3

@@ -222,7 +222,13 @@ int main(void) {
    def.max_compression, a speed beyond def.max_speed or the largest c0) is reported as
    SPH_ERR_UNSTABLE at the step where it happens, naming the first offending particle. The
    library never calls exit or abort on user input and never drops particles: particles leaving
-   def.domain are counted in w.stats.n_outside and kept.
+   def.domain are counted in w.stats.n_outside and kept. An allocation that fails makes the call
+   return SPH_ERR_NOMEM ("out of memory" in w.error) with nothing added and no step taken (a step
+   may have re-sorted the particles, and a step or sph_set_hydrostatic chosen automatic sound
+   speeds, first); the world stays usable, repeating the call once memory is available gives
+   what an uninterrupted run gives (bit for bit; the second-order scheme only to round-off if its
+   lists had to grow mid-step), and sph_world_free releases everything (tests/test_oom.c fails
+   every allocation in turn).
 
    DETERMINISM
    Reductions combine fixed blocks of particles in a fixed order and every loop is a gather, so
@@ -406,7 +412,7 @@ SPHDEF sph_status sph_grid_init(sph_grid* g, int dim, sph_real cell_size, const 
 SPHDEF void sph_grid_free(sph_grid* g);
 /* Sorts n points x[i*dim + k] into cells (counting sort). x must stay valid for queries.
    Points may lie anywhere (periodic directions wrap them). SPH_ERR_CAPACITY beyond 2^32 - 2
-   points, SPH_ERR_NOMEM; memory is reused between builds. */
+   points, SPH_ERR_NOMEM (the grid then keeps its last build); memory is reused between builds. */
 SPHDEF sph_status sph_grid_build(sph_grid* g, const sph_real* x, size_t n);
 /* Indices of the built points within radius (< radius, radius <= cell) of point p. Writes at most
    cap indices to out and returns the total number found (compare with cap). */
@@ -434,7 +440,8 @@ typedef struct sph_neighbors {
 /* Builds the lists of all grid points within radius of each query point xq[i*dim + k].
    x is the array the grid was built on. exclude_self: xq is that same point set, and a point is
    not listed as its own neighbour. Memory is reused between builds and grows only when needed.
-   SPH_ERR_ARG for radius not in (0, g->cell] or a NULL array; SPH_ERR_NOMEM. */
+   SPH_ERR_ARG for radius not in (0, g->cell] or a NULL array; SPH_ERR_NOMEM (the lists are then
+   empty, n = 0, until a build succeeds). */
 SPHDEF sph_status sph_neighbors_build(sph_neighbors* nl, const sph_grid* g, const sph_real* x,
                                       const sph_real* xq, size_t nq, sph_real radius,
                                       int exclude_self);
@@ -1061,10 +1068,10 @@ SPHDEF sph_status sph_world_copy(sph_world* dst, const sph_world* src);
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h> /* qsort; and malloc when no allocator is given (it was included only then) */
 #include <string.h>
 
 #if !defined(SPH_MALLOC) && !defined(SPH_REALLOC) && !defined(SPH_FREE)
-#include <stdlib.h>
 #define SPH_MALLOC(size) malloc(size)
 #define SPH_REALLOC(ptr, size) realloc(ptr, size)
 #define SPH_FREE(ptr) free(ptr)
@@ -1526,11 +1533,8 @@ SPHDEF sph_status sph_grid_build(sph_grid* g, const sph_real* x, size_t n) {
         }
     }
     if (n == 0) for (k = 0; k < dim; ++k) cmin[k] = cmax[k] = 0;
-    for (k = 0; k < dim; ++k) {
-        g->cmin[k] = cmin[k];
-        g->ext[k] = cmax[k] - cmin[k] + 1;
-        if (cells <= ((uint64_t)1 << 40)) cells *= (uint64_t)g->ext[k];
-    }
+    for (k = 0; k < dim; ++k)
+        if (cells <= ((uint64_t)1 << 40)) cells *= (uint64_t)(cmax[k] - cmin[k] + 1);
     if (cells <= (uint64_t)(4 * n + 1024)) {
         nbucket = (size_t)cells;
     } else {
@@ -1542,6 +1546,12 @@ SPHDEF sph_status sph_grid_build(sph_grid* g, const sph_real* x, size_t n) {
         size_t cap = nbucket + nbucket / 4 + 16;
         if (!sph__grow((void**)&g->start, cap, sizeof(uint32_t))) return SPH_ERR_NOMEM;
         g->cap_bucket = cap;
+    }
+    /* the new box only now: out of memory above leaves the last build whole (it used to get
+       this build's cmin/ext with the last build's buckets) */
+    for (k = 0; k < dim; ++k) {
+        g->cmin[k] = cmin[k];
+        g->ext[k] = cmax[k] - cmin[k] + 1;
     }
     g->hashed = hashed;
     g->nbucket = nbucket;
@@ -1719,6 +1729,15 @@ SPH__INLINE size_t sph__neighbors_chunk_dense(sph_neighbors* nl, const sph_grid*
     return pos - nl->chunk_off[c];
 }
 
+/* Out of memory in a build: the lists are left empty (n = 0), not half rebuilt (begin/count of
+   the failed pass may point past idx); every array stays allocated and accounted for. */
+static sph_status sph__neighbors_nomem(sph_neighbors* nl) {
+    nl->n = 0;
+    nl->nchunk = 0;
+    nl->total = 0;
+    return SPH_ERR_NOMEM;
+}
+
 static sph_status sph__neighbors_build(sph_neighbors* nl, const sph_grid* g, const sph_real* x,
                                        const uint32_t* order, const sph_real* xq, size_t nq,
                                        sph_real radius, int exclude_self) {
@@ -1728,15 +1747,15 @@ static sph_status sph__neighbors_build(sph_neighbors* nl, const sph_grid* g, con
         size_t cap = nq + nq / 4 + 16;
         if (!sph__grow((void**)&nl->begin, cap, sizeof(size_t)) ||
             !sph__grow((void**)&nl->count, cap, sizeof(uint32_t)))
-            return SPH_ERR_NOMEM;
+            return sph__neighbors_nomem(nl);
         nl->cap_n = cap;
     }
     if (nchunk > nl->cap_chunk) {
         size_t cap = nchunk + nchunk / 4 + 4;
         if (!sph__grow((void**)&nl->chunk_off, cap + 1, sizeof(size_t)) ||
             !sph__grow((void**)&nl->chunk_need, cap, sizeof(size_t)))
-            return SPH_ERR_NOMEM;
-        if (!sph__grow((void**)&nl->chunk_cap, cap, sizeof(size_t))) return SPH_ERR_NOMEM;
+            return sph__neighbors_nomem(nl);
+        if (!sph__grow((void**)&nl->chunk_cap, cap, sizeof(size_t))) return sph__neighbors_nomem(nl);
         for (c = nl->cap_chunk; c < cap; ++c) nl->chunk_cap[c] = 0;
         nl->cap_chunk = cap;
     }
@@ -1749,7 +1768,8 @@ static sph_status sph__neighbors_build(sph_neighbors* nl, const sph_grid* g, con
         total_cap = 0;
         for (c = 0; c < nchunk; ++c) { nl->chunk_off[c] = total_cap; total_cap += nl->chunk_cap[c]; }
         if (total_cap > nl->cap_idx) {
-            if (!sph__grow((void**)&nl->idx, total_cap, sizeof(uint32_t))) return SPH_ERR_NOMEM;
+            if (!sph__grow((void**)&nl->idx, total_cap, sizeof(uint32_t)))
+                return sph__neighbors_nomem(nl);
             nl->cap_idx = total_cap;
         }
         const int fast = !order && !g->hashed && !g->periodic[0] && !g->periodic[1] &&
@@ -2889,10 +2909,11 @@ typedef struct sph__ctx {
    across the interface (at 1000:1 a wall particle beside the air, one spacing above the water,
    gets -rho_w g dx, hundreds of pascals below the air's pressure, and pulls the air into the
    wall). Each phase sees the wall extrapolated from its own particles only. */
-static int sph__phase_walls(const sph_world* w) {
+static int sph__phase_walls_for(const sph_world* w, int solver) {
     return w->nphase > 1 && w->nb > 0 && w->def.boundary_pressure == SPH_BP_EXTRAPOLATE &&
-           (w->priv.solver == SPH_SOLVER_WCSPH || w->priv.solver == SPH_SOLVER_COMPRESSIBLE);
+           (solver == SPH_SOLVER_WCSPH || solver == SPH_SOLVER_COMPRESSIBLE);
 }
+static int sph__phase_walls(const sph_world* w) { return sph__phase_walls_for(w, w->priv.solver); }
 
 static void sph__ctx_init(sph_world* w, sph__ctx* c) {
     int k, q;
@@ -3304,11 +3325,13 @@ static sph_status sph__stage_neighbors(sph_world* w) {
         if (s != SPH_OK) return sph__fail(w, s, -1, "boundary grid: %s", sph_status_string(s));
         narr = sph__boundary_arrays(w, arr);
         sph__permute(w, arr, narr, w->priv.bgrid.order, w->nb);
-        w->priv.b_dirty = 0;
         if (w->def.boundary_volume == SPH_BVOL_AKINCI) {
             s = sph__stage_boundary_volume(w);
             if (s != SPH_OK) return s;
         }
+        /* only now: out of memory for the Akinci volumes must leave the walls dirty, or static
+           walls would keep their given volumes for good */
+        w->priv.b_dirty = 0;
     }
     s = sph__neighbors_build(&w->priv.ff, &w->priv.grid, w->x, NULL, w->x, w->n, R, 1);
     if (s == SPH_OK && w->nb > 0) {
@@ -3857,7 +3880,24 @@ static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, s
     return sph__integrate_with(w, c, w->a, kv, kr, kx, final);
 }
 
-/* Common start of every step: input checks, automatic sound speeds, stats reset. */
+/* Room for the per-block reductions of any step of the world's n particles (sph__integrate_with's
+   SPH__RED_N values per block are the most a step uses; PCISPH and IISPH need 2 and 1). Reserved
+   by sph__step_begin, before a step changes anything: the steps used to grow it in their last
+   sph__integrate, after they had advanced the particles and w->time, so running out of memory
+   there left a half-done step that a repeated call advanced again. */
+static sph_status sph__reserve_blocks(sph_world* w) {
+    const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
+    if (nblk * SPH__RED_N > w->priv.block_cap) {
+        const size_t cap = nblk * SPH__RED_N + 64;
+        if (!sph__grow((void**)&w->priv.block, cap, sizeof(double)))
+            return sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory (reduction blocks)");
+        w->priv.block_cap = cap;
+    }
+    return SPH_OK;
+}
+
+/* Common start of every step: input checks, the step-independent scratch, automatic sound
+   speeds, stats reset. */
 static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) {
     sph_status s;
     int k;
@@ -3869,6 +3909,11 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
                                  "step: phase %d has a gas equation of state, which needs the "
                                  "internal energy only sph_step_compressible evolves", k);
     s = sph__check_step_input(w, dt);
+    if (s != SPH_OK) return s;
+    /* scratch first, so that running out of memory here changes nothing */
+    s = sph__reserve_blocks(w);
+    if (s == SPH_OK && sph__phase_walls_for(w, (int)solver))
+        s = sph__scratch(w, &w->priv.bpq, w->nb * (size_t)w->nphase * 2);
     if (s != SPH_OK) return s;
     s = sph__resolve_sound_speed(w);
     if (s != SPH_OK) {
@@ -3886,7 +3931,6 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
     w->error_index = -1;
     w->status = SPH_OK;
     w->priv.solver = (int)solver;
-    if (sph__phase_walls(w)) return sph__scratch(w, &w->priv.bpq, w->nb * (size_t)w->nphase * 2);
     return SPH_OK;
 }
 
@@ -3911,6 +3955,21 @@ static sph_status sph__prepare_forces(sph_world* w, sph__ctx* c, double t, doubl
     if (w->nb > 0) sph__stage_wall(w, c, SPH__WALL_STATE | SPH__WALL_PRESSURE);
     sph__time(w, SPH_STAGE_PRESSURE, t0);
     return SPH_OK;
+}
+
+/* Stormer-Verlet drifts the particles half a step before its neighbour search. When the search
+   fails (out of memory: the grid or the lists had to grow), the step returns with the positions
+   of the step's start, kept in xn before the drift, or a repeated call would drift them twice;
+   if the particles were already sorted, xn is read through the sort's permutation. */
+static void sph__undo_drift(sph_world* w, const sph_real* xn, uint64_t sorts) {
+    const size_t D = (size_t)w->dim;
+    size_t i;
+    if (w->priv.sorts == sorts) {
+        memcpy(w->x, xn, w->n * D * sizeof(sph_real));
+        return;
+    }
+    for (i = 0; i < w->n; ++i)
+        memcpy(w->x + i * D, xn + (size_t)w->priv.grid.order[i] * D, D * sizeof(sph_real));
 }
 
 /* ============================================================================================== */
@@ -3961,6 +4020,7 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
     const int cont = w->def.density != SPH_DENSITY_SUMMATION;
     const sph_real half = SPH__R(0.5) * dt;
     double t0 = sph__now(), tstart = t0;
+    uint64_t sorts;
     sph__ctx c;
     sph_status s;
     sph__idx i;
@@ -3968,6 +4028,10 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
         s = sph__scratch(w, &w->priv.rho_n, w->capacity);
         if (s != SPH_OK) return s;
     }
+    /* x^n, to undo the drift if the neighbour search runs out of memory (sph__undo_drift) */
+    s = sph__scratch(w, &w->priv.xp, w->capacity * (size_t)w->dim);
+    if (s != SPH_OK) return s;
+    memcpy(w->priv.xp, w->x, w->n * (size_t)w->dim * sizeof(sph_real));
     sph__ctx_init(w, &c);
     s = sph__integrate(w, &c, 0, 0, half, 0); /* drift */
     if (s != SPH_OK) return s;
@@ -3975,8 +4039,12 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
     s = sph__boundary_motion(w, w->time + (double)half);
     if (s != SPH_OK) return s;
     sph__time(w, SPH_STAGE_BOUNDARY, &t0);
+    sorts = w->priv.sorts;
     s = sph__stage_neighbors(w);
-    if (s != SPH_OK) return s;
+    if (s != SPH_OK) {
+        sph__undo_drift(w, w->priv.xp, sorts);
+        return s;
+    }
     sph__ctx_init(w, &c);
     sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
     if (cont) {
@@ -4282,7 +4350,9 @@ static void sph__soc_wrap(sph_world* w, const sph__ctx* c, sph_real* x) {
 }
 
 /* Iterative particle shifting with Taylor-corrected velocity and density (eq. 19-22). Returns
-   the iterations that moved particles in w->stats.iterations. */
+   the iterations that moved particles in w->stats.iterations. The new densities go to S->lap and
+   the new velocities to S->gp (once the density gradient there is used): S->x0, v0, r0 keep the
+   step's start state, which sph__step_soc restores when the shifting runs out of memory. */
 static sph_status sph__soc_shift(sph_world* w, const sph__ctx* c, const sph__soc* S) {
     const size_t n = w->n, D = (size_t)w->dim;
     const sph_kernel* k = &w->kernel;
@@ -4331,7 +4401,7 @@ static sph_status sph__soc_shift(sph_world* w, const sph__ctx* c, const sph__soc
             sph_real dr = 0;
             size_t b;
             for (b = 0; b < D; ++b) dr += S->dxs[(size_t)i * D + b] * S->gp[(size_t)i * D + b];
-            S->r0[i] = w->rho[i] + dr;
+            S->lap[i] = w->rho[i] + dr;
         }
         for (a = 0; a < D; ++a) {
             sph__soc_grad(w, nl, w->v + a, D, S->tmp);
@@ -4340,15 +4410,15 @@ static sph_status sph__soc_shift(sph_world* w, const sph__ctx* c, const sph__soc
                 sph_real dv = 0;
                 size_t b;
                 for (b = 0; b < D; ++b) dv += S->dxs[(size_t)i * D + b] * S->tmp[(size_t)i * D + b];
-                S->v0[(size_t)i * D + a] = w->v[(size_t)i * D + a] + dv;
+                S->gp[(size_t)i * D + a] = w->v[(size_t)i * D + a] + dv;
             }
         }
         SPH__OMP_FOR(n)
         for (i = 0; i < (sph__idx)n; ++i) {
             size_t b;
-            w->rho[i] = S->r0[i];
+            w->rho[i] = S->lap[i];
             for (b = 0; b < D; ++b) {
-                w->v[(size_t)i * D + b] = S->v0[(size_t)i * D + b];
+                w->v[(size_t)i * D + b] = S->gp[(size_t)i * D + b];
                 w->x[(size_t)i * D + b] += S->dxs[(size_t)i * D + b];
             }
         }
@@ -4377,9 +4447,25 @@ static void sph__soc_update(sph_world* w, const sph__ctx* c, const sph__soc* S, 
     sph__soc_wrap(w, c, w->x);
 }
 
+/* Out of memory after the first stage moved the particles (the midpoint or shifting lists, or
+   the pair scratch, had to grow): back to the step's start state x0, v0, r0, time and steps, so
+   that the step can be repeated (the lists may then differ from an uninterrupted run's). */
+static sph_status sph__soc_undo(sph_world* w, const sph__soc* S, double time, uint64_t steps,
+                                sph_status s) {
+    const size_t n = w->n, D = (size_t)w->dim;
+    memcpy(w->x, S->x0, n * D * sizeof(sph_real));
+    memcpy(w->v, S->v0, n * D * sizeof(sph_real));
+    memcpy(w->rho, S->r0, n * sizeof(sph_real));
+    w->time = time;
+    w->steps = steps;
+    return s;
+}
+
 static sph_status sph__step_soc(sph_world* w, sph_real dt) {
     const size_t n = w->n, D = (size_t)w->dim;
     const sph_real h2 = SPH__R(0.5) * dt;
+    const double time0 = w->time;
+    const uint64_t steps0 = w->steps;
     double t0 = sph__now(), tstart = t0;
     sph__ctx c;
     sph__soc S;
@@ -4399,10 +4485,10 @@ static sph_status sph__step_soc(sph_world* w, sph_real dt) {
     sph__soc_update(w, &c, &S, h2, S.v0);
     /* stage 2 at the midpoint */
     s = sph__soc_lists(w, &S, 0);
-    if (s != SPH_OK) return s;
+    if (s != SPH_OK) return sph__soc_undo(w, &S, time0, steps0, s);
     sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
     s = sph__soc_rhs(w, &c, &S, &w->priv.sgrid, &w->priv.snl);
-    if (s != SPH_OK) return s;
+    if (s != SPH_OK) return sph__soc_undo(w, &S, time0, steps0, s);
     sph__time(w, SPH_STAGE_FORCES, &t0);
     sph__soc_update(w, &c, &S, dt, w->v);
     ++w->steps;
@@ -4410,7 +4496,7 @@ static sph_status sph__step_soc(sph_world* w, sph_real dt) {
     sph__time(w, SPH_STAGE_INTEGRATE, &t0);
     if (w->def.shift_every > 0 && w->steps % (uint64_t)w->def.shift_every == 0) {
         s = sph__soc_shift(w, &c, &S);
-        if (s != SPH_OK) return s;
+        if (s != SPH_OK) return sph__soc_undo(w, &S, time0, steps0, s);
         sph__time(w, SPH_STAGE_INTEGRATE, &t0);
     }
     s = sph__integrate_with(w, &c, w->a, 0, 0, 0, 1); /* diagnostics and blow-up checks only */
@@ -4569,6 +4655,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
        drift for summation), so the gain doubles */
     const double S = (summation ? (double)w->priv.lattice_sum : 1.0) * (verlet ? 2.0 : 1.0);
     double t0 = sph__now(), tstart = t0, err = 0, errmax = 0, proto[SPH_MAX_PHASES];
+    uint64_t sorts;
     sph__ctx c;
     sph_status s;
     sph__idx i;
@@ -4586,6 +4673,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
         w->priv.block_cap = 2 * nblk + 64;
     }
     if (verlet) { /* first drift; the correction then runs at the half step */
+        memcpy(w->priv.xp, w->x, nD * sizeof(sph_real)); /* x^n for sph__undo_drift */
         sph__ctx_init(w, &c);
         s = sph__integrate(w, &c, 0, 0, SPH__R(0.5) * dt, 0);
         if (s != SPH_OK) return s;
@@ -4593,8 +4681,12 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
     s = sph__boundary_motion(w, w->time + (verlet ? 0.5 * (double)dt : 0.0));
     if (s != SPH_OK) return s;
     sph__time(w, SPH_STAGE_BOUNDARY, &t0);
+    sorts = w->priv.sorts;
     s = sph__stage_neighbors(w);
-    if (s != SPH_OK) return s;
+    if (s != SPH_OK) {
+        if (verlet) sph__undo_drift(w, w->priv.xp, sorts);
+        return s;
+    }
     sph__ctx_init(w, &c);
     /* delta-SPH needs a speed of sound, which PCISPH does not have (seed 000 sec. 3.2.1 leaves it
        open). The phase's c0 would make the explicit diffusion unstable at PCISPH's large steps

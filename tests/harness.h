@@ -39,6 +39,7 @@ extern const th_test tests_io[];
 extern const th_test tests_save[];
 extern const th_test tests_reliability[];
 extern const th_test tests_reliability_long[];
+extern const th_test tests_oom[]; /* out of memory: every allocation failing once */
 
 void th_fail(const char* file, int line, const char* fmt, ...);
 void th_note(const char* fmt, ...);
