@@ -169,5 +169,8 @@ check-realtime:
 check-integration:
 	tests/check_integration.sh $(CURDIR)/$(B)/integration
 
+# Fuzzing (libFuzzer; make fuzz, make fuzz-replay)
+include tests/fuzz.mk
+
 clean:
 	rm -rf $(B) out
