@@ -14,8 +14,8 @@
        phase), the walls' count, the time and the step count unchanged (the documented exception:
        a boundary-motion callback that wrote a non-finite value);
      - w.n and w.nb never decrease; sph_stable_dt returns a finite value >= 0 (0 with an error);
-     - a step or sph_advance that returns SPH_OK leaves finite positions, velocities, densities
-       and pressures (blow-ups are SPH_ERR_UNSTABLE).
+     - a step or sph_advance that returns SPH_OK after stepping leaves finite positions,
+       velocities, densities and pressures (blow-ups are SPH_ERR_UNSTABLE).
    The work is bounded: at most FZ_MAX_FLUID fluid and FZ_MAX_WALL wall particles (fewer with a
    large h_factor or the second-order scheme), at most 10 steps, iteration limits of at most 40,
    sph_advance over at most a few stable steps.
@@ -685,13 +685,12 @@ static void fz_steps(fz_ctx* c) {
                  : which == 2 ? "sph_step_pcisph" : which == 3 ? "sph_step_compressible" : "sph_step";
         }
         fz_after(what, w, s, &before, 1);
-        if (s == SPH_OK) {
+        if (s == SPH_OK && w->steps > before.steps) { /* sph_advance may take no step */
             fz_check_finite(what, w);
             /* a step that passes its input checks resets w.status (sph_advance over no step
                leaves the status of an earlier failing call) */
-            if (w->steps > before.steps)
-                FZ_ASSERT(w->status == SPH_OK, "%s returned SPH_OK but w.status is %s", what,
-                          sph_status_string(w->status));
+            FZ_ASSERT(w->status == SPH_OK, "%s returned SPH_OK but w.status is %s", what,
+                      sph_status_string(w->status));
         }
         /* the read-only queries */
         {
