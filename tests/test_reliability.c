@@ -307,8 +307,13 @@ static void vortex_box(int which, sph_boundary_pressure bp, int expect_stable) {
                   solver_name(&def), rise / ke0);
         CHECK_LT(last, 0.9 * ke0);
     } else {
-        CHECK_MSG(s == SPH_ERR_UNSTABLE, "%s bp %d: the known energy gain was not reported (KE "
-                  "%.3g of its start)", solver_name(&def), (int)bp, last / ke0);
+        /* the known energy gain: in double the speed bound reports it by t = 0.4 s; in float the
+           growth starts later (KE 4 and 16 times its start at t = 0.4 s, not yet 10 m/s), so
+           the test accepts either the report or a kinetic energy beyond twice its start, which
+           w.stats.kinetic_energy shows a host */
+        CHECK_MSG(s == SPH_ERR_UNSTABLE || (s == SPH_OK && last > 2 * ke0),
+                  "%s bp %d: the known energy gain was neither reported nor visible (KE %.3g of "
+                  "its start)", solver_name(&def), (int)bp, last / ke0);
     }
     TH_NOTE("%-12s %-11s vortex box: %s at t = %.2f s, KE / KE(0) = %.3f, largest rise between "
             "samples %.2g of KE(0), %d of 20 samples with the solve at max_iterations",
