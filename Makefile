@@ -157,6 +157,9 @@ check-vtk: | $(B)
 	$(VTK_PYTHON) tests/check_vtk.py $(B)/vtk
 	$(VTK_PYTHON) tests/check_vtk.py $(B)/vtk_f
 
+print-test-src:
+	@echo $(TEST_SRC)
+
 # ThreadSanitizer over the OpenMP loops (clang + libomp + Archer; prints SKIP without them).
 check-tsan:
 	tests/check_tsan.sh $(B)/tsan

@@ -41,10 +41,8 @@ printf 'int main(void){return 0;}\n' > "$B/probe.c"
 "$CLANG" -fsanitize=thread -fopenmp=libomp "$B/probe.c" -o "$B/probe" >/dev/null 2>&1 \
     || skip "clang cannot link -fsanitize=thread -fopenmp=libomp (apt-get install libomp-14-dev libclang-rt-14-dev)"
 
-TEST_SRC="tests/main.c tests/impl.c tests/test_kernels.c tests/test_grid.c tests/test_operators.c
- tests/test_world.c tests/test_wcsph.c tests/test_pcisph.c tests/test_iisph.c
- tests/test_compressible.c tests/test_soc.c tests/test_io.c tests/test_save.c
- tests/test_reliability.c tests/test_compile.c tests/compile_second.c tests/compile_static.c"
+# the test sources are the Makefile's TEST_SRC (one list to keep up to date)
+TEST_SRC=$(make -s --no-print-directory print-test-src) || skip "cannot read TEST_SRC from the Makefile"
 FLAGS="-fsanitize=thread -fopenmp=libomp -g -O1 -fno-omit-frame-pointer -Wall -Wextra -Wpedantic -Wshadow"
 
 echo "check_tsan: building into $B ($("$CLANG" --version | head -1); Archer: $ARCHER)"
