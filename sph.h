@@ -3965,7 +3965,7 @@ static void sph__undo_drift(sph_world* w, const sph_real* xn, uint64_t sorts) {
     const size_t D = (size_t)w->dim;
     size_t i;
     if (w->priv.sorts == sorts) {
-        memcpy(w->x, xn, w->n * D * sizeof(sph_real));
+        sph__copy(w->x, xn, w->n * D * sizeof(sph_real));
         return;
     }
     for (i = 0; i < w->n; ++i)
@@ -4031,7 +4031,7 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
     /* x^n, to undo the drift if the neighbour search runs out of memory (sph__undo_drift) */
     s = sph__scratch(w, &w->priv.xp, w->capacity * (size_t)w->dim);
     if (s != SPH_OK) return s;
-    memcpy(w->priv.xp, w->x, w->n * (size_t)w->dim * sizeof(sph_real));
+    sph__copy(w->priv.xp, w->x, w->n * (size_t)w->dim * sizeof(sph_real));
     sph__ctx_init(w, &c);
     s = sph__integrate(w, &c, 0, 0, half, 0); /* drift */
     if (s != SPH_OK) return s;
@@ -4453,7 +4453,7 @@ static void sph__soc_update(sph_world* w, const sph__ctx* c, const sph__soc* S, 
 static sph_status sph__soc_undo(sph_world* w, const sph__soc* S, double time, uint64_t steps,
                                 sph_status s) {
     const size_t n = w->n, D = (size_t)w->dim;
-    memcpy(w->x, S->x0, n * D * sizeof(sph_real));
+    sph__copy(w->x, S->x0, n * D * sizeof(sph_real));
     memcpy(w->v, S->v0, n * D * sizeof(sph_real));
     memcpy(w->rho, S->r0, n * sizeof(sph_real));
     w->time = time;
@@ -4673,7 +4673,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
         w->priv.block_cap = 2 * nblk + 64;
     }
     if (verlet) { /* first drift; the correction then runs at the half step */
-        memcpy(w->priv.xp, w->x, nD * sizeof(sph_real)); /* x^n for sph__undo_drift */
+        sph__copy(w->priv.xp, w->x, nD * sizeof(sph_real)); /* x^n for sph__undo_drift */
         sph__ctx_init(w, &c);
         s = sph__integrate(w, &c, 0, 0, SPH__R(0.5) * dt, 0);
         if (s != SPH_OK) return s;
