@@ -4,34 +4,14 @@
 #include "harness.h"
 #include "../sph.h"
 #include "../examples/scenes.h"
+#include "state_hash.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 /* FNV-1a over the state a user sees: fluid x, v, rho, p, id, (e), boundary x, v, p, time. */
-static uint64_t fnv(uint64_t h, const void* data, size_t n) {
-    const unsigned char* p = (const unsigned char*)data;
-    size_t i;
-    for (i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
-    return h;
-}
-
-static uint64_t world_hash(const sph_world* w) {
-    const size_t d = (size_t)w->dim, r = sizeof(sph_real);
-    uint64_t h = 14695981039346656037ull;
-    h = fnv(h, w->x, w->n * d * r);
-    h = fnv(h, w->v, w->n * d * r);
-    h = fnv(h, w->rho, w->n * r);
-    h = fnv(h, w->p, w->n * r);
-    h = fnv(h, w->id, w->n * sizeof(uint32_t));
-    if (w->e) h = fnv(h, w->e, w->n * r);
-    h = fnv(h, w->b_x, w->nb * d * r);
-    h = fnv(h, w->b_v, w->nb * d * r);
-    h = fnv(h, w->b_p, w->nb * r);
-    h = fnv(h, &w->time, sizeof w->time);
-    return h;
-}
+#define world_hash th_state_hash
 
 typedef sph_status (*scene_fn)(sph_world* w);
 
