@@ -404,8 +404,9 @@ typedef struct sph_grid {
 
 /* Sets up an empty grid. cell_size >= the largest query radius [m]. periodic may be NULL (no
    direction periodic); lo/hi give the periodic box and are read only for periodic directions,
-   whose length hi - lo must be finite and at least 2 * cell_size. SPH_ERR_ARG for g NULL, dim outside 1..3, a
-   cell_size not finite and > 0, or a bad periodic box. Overwrites *g: free a built grid first. */
+   whose length hi - lo must be finite and at least 2 * cell_size. SPH_ERR_ARG for g NULL, dim
+   outside 1..3, a cell_size not finite and > 0, or a bad periodic box. Overwrites *g: free a
+   built grid first. */
 SPHDEF sph_status sph_grid_init(sph_grid* g, int dim, sph_real cell_size, const int* periodic,
                                 const sph_real* lo, const sph_real* hi);
 /* Releases the arrays; the grid keeps its cells and may be built again. NULL is ignored. */
@@ -1489,7 +1490,8 @@ SPHDEF sph_status sph_grid_init(sph_grid* g, int dim, sph_real cell_size, const 
             g->lo[k] = lo[k];
             g->len[k] = len;
             /* clamp before the conversion: a long box has more cells than int32_t holds */
-            g->ncell[k] = (int32_t)fmin(floor((double)len / (double)cell_size), (double)SPH__CELL_LIM);
+            g->ncell[k] =
+                (int32_t)fmin(floor((double)len / (double)cell_size), (double)SPH__CELL_LIM);
             g->inv[k] = (1.0 - 1.0 / 1073741824.0) * (double)g->ncell[k] / (double)len;
         }
     }
@@ -5202,8 +5204,9 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
     /* valid but extreme input (a cfl factor of 1e-320, speeds near overflow) can round the step
        to 0 in sph_real: report it instead of returning 0 with no error */
     if (!((sph_real)dt > 0)) {
-        sph__fail(w, SPH_ERR_UNSTABLE, -1, "sph_stable_dt: the stable step (%g s) rounds to 0 in sph_real; "
-                  "check the def.cfl* factors and the speeds", dt);
+        sph__fail(w, SPH_ERR_UNSTABLE, -1,
+                  "sph_stable_dt: the stable step (%g s) rounds to 0 in sph_real; check the "
+                  "def.cfl* factors and the speeds", dt);
         return 0;
     }
     return (sph_real)dt;

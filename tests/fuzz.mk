@@ -7,7 +7,7 @@
 #                      FUZZ_DEFS=-DSPH_FLOAT fuzzes the float build; FUZZ_ARGS passes libFuzzer flags.
 #   make fuzz-replay   runs the regression inputs and the seeds through the same harness without
 #                      libFuzzer (tests/fuzz_replay.c), built with $(CC) and ASan + UBSan, in
-#                      double and in float (SPH_FLOAT).
+#                      double and in float (SPH_FLOAT), and with clang when there is one.
 # A crash found by make fuzz: fix it, then keep the input as a regression:
 #   cp $(B)/fuzz_artifacts/crash-... tests/fuzz_corpus/regressions/<what-it-was>.bin
 # and FUZZ_VERBOSE=1 $(B)/fuzz_replay <file> prints what an input does.
@@ -18,7 +18,10 @@ FUZZ_TIMEOUT ?= 25
 FUZZ_RSS     ?= 2048
 FUZZ_ARGS    ?=
 FUZZ_DEFS    ?=
-FUZZ_SAN      = -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
+# float-cast-overflow: gcc's -fsanitize=undefined leaves it out (clang's includes it)
+FUZZ_SAN      = -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all \
+                -fno-omit-frame-pointer
+FUZZ_RUN      = ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1
 FUZZ_INPUTS   = $(wildcard tests/fuzz_corpus/regressions/*.bin) $(wildcard tests/fuzz_corpus/seed-*.bin)
 FUZZ_DEP      = sph.h tests/fuzz_world.c
 
@@ -41,8 +44,15 @@ fuzz: | $(B)
 	    -timeout=$(FUZZ_TIMEOUT) -rss_limit_mb=$(FUZZ_RSS) -artifact_prefix=$(B)/fuzz_artifacts/ \
 	    -print_final_stats=1 $(FUZZ_ARGS)
 
+# With clang available the inputs also run under clang's UBSan, which checks what gcc's does not
+# (e.g. NULL + 0, one of the regressions).
 fuzz-replay: $(FUZZ_DEP) tests/fuzz_replay.c | $(B)
 	$(CC) -g -O1 -std=c99 $(WARN) $(FUZZ_SAN) -I. tests/fuzz_world.c tests/fuzz_replay.c -o $(B)/fuzz_replay -lm
 	$(CC) -g -O1 -std=c99 $(WARN) $(FUZZ_SAN) -DSPH_FLOAT -I. tests/fuzz_world.c tests/fuzz_replay.c -o $(B)/fuzz_replay_f -lm
-	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ./$(B)/fuzz_replay $(FUZZ_INPUTS)
-	ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1 ./$(B)/fuzz_replay_f $(FUZZ_INPUTS)
+	$(FUZZ_RUN) ./$(B)/fuzz_replay $(FUZZ_INPUTS)
+	$(FUZZ_RUN) ./$(B)/fuzz_replay_f $(FUZZ_INPUTS)
+	@if command -v $(FUZZ_CC) >/dev/null 2>&1; then \
+	    echo "$(FUZZ_CC) ... -o $(B)/fuzz_replay_clang"; \
+	    $(FUZZ_CC) -g -O1 -std=c99 $(WARN) $(FUZZ_SAN) -I. tests/fuzz_world.c tests/fuzz_replay.c \
+	        -o $(B)/fuzz_replay_clang -lm && $(FUZZ_RUN) ./$(B)/fuzz_replay_clang $(FUZZ_INPUTS); \
+	else echo "fuzz-replay: $(FUZZ_CC) not found, the clang replay is skipped"; fi

@@ -31,7 +31,8 @@ REAL_FIELDS += [("force_k", -100, 100), ("omega_cb", 0, 200)]
 RANGES = dict((name, (lo, hi)) for name, lo, hi in REAL_FIELDS)
 PHASE_REALS = [("rest_density", 0, 3000), ("viscosity", 0, 0.01), ("sound_speed", 0, 100),
                ("gamma", 1, 20), ("back_pressure", -100, 1e5), ("mass", 0, 10)]
-SPECIAL = {"zero": 0, "-1": 1, "nan": 2, "inf": 3, "-inf": 4, "1e300": 5, "-1e300": 6, "1e6": 16}
+SPECIAL = {"zero": 0, "-1": 1, "nan": 2, "inf": 3, "-inf": 4, "1e300": 5, "-1e300": 6,
+           "4.9e-324": 8, "3.5e38": 13, "1e6": 16}
 
 
 def real(value, lo, hi):
@@ -194,6 +195,18 @@ def main():
         with open(os.path.join(outdir, "seed-%s.bin" % name), "wb") as f:
             f.write(data)
     print("wrote %d seeds to %s" % (len(S), outdir))
+    # Regressions rebuilt by hand in the current layout (the fuzzer's own inputs for these two
+    # bugs predate a change of the special values): a PCISPH step limit that rounds to 0 with
+    # no error, and a wall box whose span (3.5e38 spacings) overflowed the size_t conversion.
+    R = {}
+    R["stable-dt-underflow-no-error"] = seed(defs={"solver": 128 + 2, "cfl_force": "4.9e-324"})
+    R["wall-box-span-overflow-cast"] = seed(ops=[wall((0, 0, 0), ("3.5e38", 4, 4))])
+    rdir = os.path.join(outdir, "regressions")
+    os.makedirs(rdir, exist_ok=True)
+    for name, data in R.items():
+        with open(os.path.join(rdir, "%s.bin" % name), "wb") as f:
+            f.write(data)
+    print("wrote %d regressions to %s" % (len(R), rdir))
 
 
 if __name__ == "__main__":

@@ -169,6 +169,14 @@ static fz_state fz_take(const sph_world* w) {
     return s;
 }
 
+/* Before a checked call: clears w.error and w.status (the library only writes them), so that a
+   failure which sets no message or status is caught rather than hidden by an older one. */
+static fz_state fz_begin(sph_world* w) {
+    w->error[0] = 0;
+    w->status = SPH_OK;
+    return fz_take(w);
+}
+
 static int fz_same(const fz_state* a, const fz_state* b) {
     return a->n == b->n && a->nb == b->nb && a->steps == b->steps && a->sum == b->sum &&
            memcmp(&a->time, &b->time, sizeof(double)) == 0;
@@ -390,6 +398,7 @@ static void fz_phases(fz_ctx* c) {
         ph.back_pressure = (sph_real)fz_real(r, ph.eos == SPH_EOS_IDEAL_GAS ? 1e5 : 0, -100, 1e5);
         ph.mass = (sph_real)fz_real(r, 0, 0, 10);
         if (slot >= count) continue;
+        (void)fz_begin(&c->w);
         idx = sph_world_add_phase(&c->w, &ph);
         FZ_LOG("  add_phase eos %d rho0 %g c0 %g gamma %g pb %g m %g -> %d %s\n", (int)ph.eos,
                (double)ph.rest_density, (double)ph.sound_speed, (double)ph.gamma,
@@ -476,7 +485,7 @@ static void fz_op(fz_ctx* c) {
     sph_world* w = &c->w;
     const int dim = w->dim;
     const unsigned type = fz_u8(r) % 6u;
-    fz_state before = fz_take(w);
+    fz_state before = fz_begin(w);
     sph_status s;
     sph_real lo[3], hi[3];
     if (type == 0) { /* sph_fill_box */
@@ -577,10 +586,42 @@ static void fz_op(fz_ctx* c) {
         }
         free(x);
         free(vol);
-    } else { /* sph_set_hydrostatic */
+    } else if (type == 5) { /* sph_set_hydrostatic */
         s = sph_set_hydrostatic(w);
         fz_after("sph_set_hydrostatic", w, s, &before, 0);
     }
+}
+
+/* NULL arguments are rejected and change nothing (run once per input, after the ops; no bytes
+   read, so the decoding of stored inputs stays the same). */
+static void fz_null_args(fz_ctx* c) {
+    sph_world* w = &c->w;
+    sph_real box[3] = {0, 0, 0};
+    unsigned which;
+    for (which = 0; which < 5; ++which) {
+        fz_state before = fz_begin(w);
+        sph_status s;
+        if (which == 0) s = sph_fill_box(w, 0, NULL, box);
+        else if (which == 1) s = sph_fill_box(w, 0, box, NULL);
+        else if (which == 2) s = sph_add_wall_box(w, NULL, box, 0, 0);
+        else if (which == 3) s = sph_add_boundary(w, 3, NULL, NULL, 0);
+        else s = sph_add_fluid_ex(w, 0, 2, NULL, NULL, NULL, NULL);
+        FZ_ASSERT(s != SPH_OK, "a NULL argument was accepted (%u)", which);
+        fz_after("NULL argument", w, s, &before, 1);
+    }
+    {
+        const int np = w->nphase;
+        FZ_ASSERT(sph_world_add_phase(w, NULL) == -1 && w->error[0] != 0 && w->nphase == np,
+                  "add_phase(NULL)");
+    }
+    FZ_ASSERT(sph_fill_box(NULL, 0, box, box) == SPH_ERR_ARG, "fill_box(NULL world)");
+    FZ_ASSERT(sph_step(NULL, 1) == SPH_ERR_ARG, "step(NULL)");
+    FZ_ASSERT(sph_advance(NULL, 1) == SPH_ERR_ARG, "advance(NULL)");
+    FZ_ASSERT(sph_stable_dt(NULL, SPH_SOLVER_WCSPH) == 0, "stable_dt(NULL)");
+    FZ_ASSERT(sph_set_hydrostatic(NULL) == SPH_ERR_ARG, "set_hydrostatic(NULL)");
+    FZ_ASSERT(sph_world_add_phase(NULL, NULL) == -1, "add_phase(NULL, NULL)");
+    sph_world_free(NULL);
+    sph_world_def_pcisph(NULL, 1);
 }
 
 /* The default scene when the op count byte is 0: a column of fluid in an open tank. */
@@ -598,13 +639,13 @@ static void fz_default_scene(fz_ctx* c) {
     }
     if (w->dim == 1) { hi[0] = (sph_real)(20 * dx); whi[0] = hi[0]; }
     if (fz_box_count(w, lo, hi, 0) > c->budget_fluid) return;
-    before = fz_take(w);
+    before = fz_begin(w);
     s = sph_fill_box(w, 0, lo, hi);
     fz_after("sph_fill_box (default)", w, s, &before, 1);
     if (w->def.periodic[0] || w->def.periodic[1] || w->def.periodic[2]) return;
     if (fz_box_count(w, lo, whi, (int)ceil((double)(w->kernel.radius / w->dx))) > c->budget_wall)
         return; /* walls as deep as a huge support: skip */
-    before = fz_take(w);
+    before = fz_begin(w);
     s = sph_add_wall_box(w, lo, whi, 0, w->dim >= 2 ? SPH_FACE_YMAX : 0);
     fz_after("sph_add_wall_box (default)", w, s, &before, 1);
 }
@@ -620,7 +661,7 @@ static sph_status fz_step_with(sph_world* w, unsigned which, sph_real dt) {
 }
 
 static sph_real fz_stable(sph_world* w, sph_solver solver) {
-    fz_state before = fz_take(w);
+    fz_state before = fz_begin(w);
     sph_real dt = sph_stable_dt(w, solver);
     FZ_LOG("  sph_stable_dt(%d)       -> %g %s\n", (int)solver, (double)dt,
            dt == 0 ? w->error : "");
@@ -648,11 +689,11 @@ static void fz_steps(fz_ctx* c) {
             dt = fz_stable(w, w->def.solver);
             if (dt == 0 && (arg & 1u)) continue;
             dt = (sph_real)((double)dt * f);
-            before = fz_take(w);
+            before = fz_begin(w);
             s = sph_step(w, dt);
         } else if (act == 4) { /* dt straight from the bytes (0, negative, NaN, huge ...) */
             dt = (sph_real)fz_real(r, 1e-4, 0, 1e-2);
-            before = fz_take(w);
+            before = fz_begin(w);
             s = sph_step(w, dt);
         } else if (act == 5) { /* sph_advance over a few stable steps, or a bad duration */
             double dur;
@@ -660,7 +701,7 @@ static void fz_steps(fz_ctx* c) {
             dur = (double)dt * 2 * f;
             if (isfinite(f) && f > 2 && f < 1e13) dur = (double)dt * 4;
             if (!isfinite(f) || f <= 0) dur = f;
-            before = fz_take(w);
+            before = fz_begin(w);
             s = sph_advance(w, (sph_real)dur);
             what = "sph_advance";
             if (s == SPH_OK) FZ_ASSERT(w->steps - before.steps <= 1000, "advance took %llu steps",
@@ -679,7 +720,7 @@ static void fz_steps(fz_ctx* c) {
             sph_solver sv = which < 4 ? (sph_solver)which : w->def.solver;
             dt = fz_stable(w, sv);
             dt = (sph_real)((double)dt * f);
-            before = fz_take(w);
+            before = fz_begin(w);
             s = fz_step_with(w, which, dt);
             what = which == 0 ? "sph_step_wcsph" : which == 1 ? "sph_step_iisph"
                  : which == 2 ? "sph_step_pcisph" : which == 3 ? "sph_step_compressible" : "sph_step";
@@ -716,6 +757,10 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     c->r.p = data;
     c->r.n = size;
     fz_def(c);
+    FZ_ASSERT(sph_world_init(NULL, &c->def) == SPH_ERR_ARG, "sph_world_init(NULL, def)");
+    s = sph_world_init(&c->w, NULL);
+    FZ_ASSERT(s == SPH_ERR_ARG && c->w.error[0] != 0, "sph_world_init(w, NULL)");
+    sph_world_free(&c->w);
     s = sph_world_init(&c->w, &c->def);
     FZ_LOG("dim %d solver %d scheme %d integrator %d density %d kernel %d dx %g h_factor %g "
            "periodic %d%d%d force %d motion %d -> %s %s\n",
@@ -741,6 +786,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     nops = fz_u8(&c->r) % 7u;
     if (nops == 0) fz_default_scene(c);
     for (q = 0; q < nops; ++q) fz_op(c);
+    fz_null_args(c);
     fz_steps(c);
     sph_world_free(&c->w);
     FZ_ASSERT(c->w.n == 0 && c->w.x == NULL && c->w.nb == 0, "sph_world_free left particles");
