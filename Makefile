@@ -6,8 +6,9 @@
 #                  float build, ParaView output); each exits non-zero if its physics check fails
 #   make check     warnings (gcc, clang, C, C++), sanitizers, float, no-OpenMP and C++ test runs
 #   make validate  the long validation runs (tests marked long)
-#   make bench     throughput (bench/bench.c) and the Taylor-Green convergence study
-#                  (bench/convergence.c), results in bench/results/; BENCH_N=40 for a quick run
+#   make bench     the benchmark driver (bench/bench.c: speed against a baseline, scaling, memory,
+#                  cost growth) and the Taylor-Green convergence study, results in bench/results/
+#   make bench-quick  the driver at small sizes (under a minute), into out/bench-quick/
 #   make paraview  the dam break as a ParaView time series: out/paraview/dambreak.pvd
 #   make realtime  the interactive SDL2 demo (optional; needs libsdl2-dev)
 #   make install   sph.h and sph.pc (pkg-config) under PREFIX (default /usr/local); CMake users
@@ -36,7 +37,7 @@ EXAMPLES = hello dambreak paraview moving_boundary external_force multiphase flo
 PREFIX  ?= /usr/local
 VTK_PYTHON ?= /usr/bin/python3
 
-.PHONY: test validate bench demo paraview realtime examples run-examples install check-tsan \
+.PHONY: test validate bench bench-quick demo paraview realtime examples run-examples install check-tsan \
         check-realtime check check-warnings check-sanitize \
         check-float check-noomp check-cpp check-png check-vtk check-integration clean
 
@@ -52,13 +53,22 @@ validate: $(B)/tests
 	./$(B)/tests --long -long/
 
 BENCH_N ?= 80
+# make bench: every suite of the benchmark driver (sph.h against its baseline, scaling, search,
+# float, memory, cost growth, optional physics) and the Taylor-Green convergence study, CSV and
+# SVG into bench/results/ (about 15 minutes on 2 cores). make bench-quick: the same suites at
+# small sizes into out/bench-quick/ (under a minute; CI runs it so the log shows a regression).
 bench: $(B)/bench $(B)/convergence
 	mkdir -p bench/results
-	./$(B)/bench dambreak2d 100 200 3 bench/results/throughput.csv
+	./$(B)/bench --out bench/results > bench/results/perf.txt; st=$$?; cat bench/results/perf.txt; exit $$st
 	./$(B)/convergence $(BENCH_N) bench/results
 
-$(B)/bench: bench/bench.c sph.h examples/scenes.h | $(B)
-	$(CC) $(CFLAGS) $(OMP) -I. bench/bench.c -o $@ -lm
+bench-quick: $(B)/bench
+	mkdir -p out/bench-quick
+	./$(B)/bench --quick --repeats 1 --out out/bench-quick
+
+BENCH_SRC = bench/bench.c bench/bench_float.c
+$(B)/bench: $(BENCH_SRC) bench/bench_core.h bench/bench_types.h bench/baseline.h bench/svg.h sph.h examples/scenes.h | $(B)
+	$(CC) $(CFLAGS) $(OMP) -I. $(BENCH_SRC) -o $@ -lm
 
 $(B)/convergence: bench/convergence.c sph.h examples/scenes.h bench/svg.h | $(B)
 	$(CC) $(CFLAGS) $(OMP) -I. bench/convergence.c -o $@ -lm

@@ -653,6 +653,78 @@ static void test_neighbors_build(void) {
     sph_neighbors_free(&nl); /* a second free is harmless */
 }
 
+/* Points the host keeps in cell order take sph_neighbors_build's fast path (rows of cells read
+   in place, cells beyond the radius skipped, a branch-free distance test); it must list exactly
+   what the brute force finds. Random points (2D, 3D) are put into cell order by the grid's own
+   permutation, plus pairs at distances just under and just over the radius straddling cell
+   faces (the skip test's margin), at the radius and at half the cell (more cells skipped), for
+   the points themselves, and for query points in, around and far outside the grid's box; then
+   compressed so every chunk overflows its first capacity. */
+static void test_neighbors_cell_ordered(void) {
+    uint64_t seed = 17;
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        const size_t nr = dim == 2 ? 2500 : 2000, npair = 200, n = nr + 2 * npair;
+        const double cell = tg_cell_for(dim, nr, 1.0, dim == 2 ? 20 : 40);
+        sph_real* x0 = tg_random_points(&seed, n, dim, 0.0, 1.0);
+        sph_real* x = (sph_real*)malloc(n * (size_t)dim * sizeof(sph_real) + 1);
+        sph_real* xq = tg_random_points(&seed, 400, dim, -0.3, 1.3);
+        tg_bf b = tg_bf_make(dim, NULL, NULL, NULL);
+        sph_grid g;
+        sph_neighbors nl;
+        size_t i, ordered = 0, self_total = 0;
+        int k, pass;
+        char what[64];
+        memset(&nl, 0, sizeof(nl));
+        if (!x0 || !x || !xq) { CHECK_MSG(0, "out of memory"); free(x0); free(x); free(xq); return; }
+        /* pairs straddling a cell face (x = 0.5 cell multiples), distance (1 -+ 1e-7) cell */
+        for (i = 0; i < npair; ++i) {
+            sph_real* a = x0 + (nr + 2 * i) * (size_t)dim;
+            sph_real* c = a + dim;
+            const double face = cell * (double)(1 + i % (size_t)(0.8 / cell));
+            const double dist = cell * (i % 2 ? 1 - 1e-7 : 1 + 1e-7);
+            const double off = 0.5 * dist * (double)(i % 5) / 4.0;
+            a[0] = (sph_real)(face - off);
+            c[0] = (sph_real)(face - off + dist);
+            for (k = 1; k < dim; ++k) c[k] = a[k];
+        }
+        for (i = 0; i < 7; ++i) /* queries far outside the box, and on its faces */
+            for (k = 0; k < dim; ++k)
+                xq[i * (size_t)dim + (size_t)k] = (sph_real)(i < 3 ? 5.0 * (double)i - 4.0 : i == 3 ? 0 : 1);
+        CHECK_EQ_INT(sph_grid_init(&g, dim, (sph_real)cell, NULL, NULL, NULL), SPH_OK);
+        for (pass = 0; pass < 2; ++pass) {
+            const double scale = pass ? 0.45 : 1.0;
+            for (i = 0; i < n * (size_t)dim; ++i) x0[i] = (sph_real)(0.3 + scale * ((double)x0[i] - 0.3));
+            CHECK_EQ_INT(sph_grid_build(&g, x0, n), SPH_OK);
+            for (i = 0; i < n; ++i) /* into cell order */
+                memcpy(x + i * (size_t)dim, x0 + (size_t)g.order[i] * (size_t)dim, (size_t)dim * sizeof(sph_real));
+            CHECK_EQ_INT(sph_grid_build(&g, x, n), SPH_OK);
+            for (i = 0, ordered = 1; i < n; ++i) ordered &= g.order[i] == (uint32_t)i;
+            CHECK_MSG(ordered, "%dD: the sorted points are not in the grid's order", dim);
+            snprintf(what, sizeof what, "%dD cell-ordered, radius = cell, pass %d", dim, pass);
+            CHECK_EQ_INT(sph_neighbors_build(&nl, &g, x, x, n, (sph_real)cell, 1), SPH_OK);
+            tg_check_lists(what, &nl, &b, x, n, x, n, (sph_real)cell, 1);
+            self_total = nl.total;
+            snprintf(what, sizeof what, "%dD cell-ordered, radius = cell / 2, pass %d", dim, pass);
+            CHECK_EQ_INT(sph_neighbors_build(&nl, &g, x, x, n, (sph_real)(0.5 * cell), 1), SPH_OK);
+            tg_check_lists(what, &nl, &b, x, n, x, n, (sph_real)(0.5 * cell), 1);
+            snprintf(what, sizeof what, "%dD cell-ordered, own points kept, pass %d", dim, pass);
+            CHECK_EQ_INT(sph_neighbors_build(&nl, &g, x, x, n, (sph_real)cell, 0), SPH_OK);
+            tg_check_lists(what, &nl, &b, x, n, x, n, (sph_real)cell, 0);
+            snprintf(what, sizeof what, "%dD cell-ordered, outside queries, pass %d", dim, pass);
+            CHECK_EQ_INT(sph_neighbors_build(&nl, &g, x, xq, 400, (sph_real)cell, 0), SPH_OK);
+            tg_check_lists(what, &nl, &b, x, n, xq, 400, (sph_real)cell, 0);
+        }
+        TH_NOTE("%dD: %lu points in cell order, %.1f neighbours each after compression", dim,
+                (unsigned long)n, (double)self_total / (double)n);
+        sph_neighbors_free(&nl);
+        sph_grid_free(&g);
+        free(x0);
+        free(x);
+        free(xq);
+    }
+}
+
 /* An empty build: queries find nothing and neighbour lists are empty; many coincident points
    (one crowded cell) are all found, each exactly once. */
 static void test_empty_and_duplicates(void) {
@@ -858,6 +930,7 @@ const th_test tests_grid[] = {
     {"grid/far_point", test_far_point},
     {"grid/clamped", test_clamped},
     {"grid/neighbors_build", test_neighbors_build},
+    {"grid/neighbors_cell_ordered", test_neighbors_cell_ordered},
     {"grid/empty_and_duplicates", test_empty_and_duplicates},
     {"grid/strict_radius", test_strict_radius},
     {"grid/bad_input", test_bad_input},
