@@ -1527,14 +1527,32 @@ SPHDEF sph_status sph_grid_build(sph_grid* g, const sph_real* x, size_t n) {
             return SPH_ERR_NOMEM;
         g->cap_n = cap;
     }
-    /* bounding box of the cells (a serial min/max pass: cheap and deterministic) */
+    /* bounding box of the cells: min and max do not depend on the order they are taken in, so
+       the parallel pass (OpenMP 3.1 min/max reductions) gives the serial result; it was the
+       largest serial part of a step (3 % at 100k particles, which 2 threads do not share) */
     for (k = 0; k < dim; ++k) { cmin[k] = SPH__CELL_LIM; cmax[k] = -SPH__CELL_LIM; }
-    for (i = 0; i < (sph__idx)n; ++i) {
-        for (k = 0; k < dim; ++k) {
-            int32_t c = sph__cell_coord(g, k, x[(size_t)i * (size_t)dim + (size_t)k]);
-            if (c < cmin[k]) cmin[k] = c;
-            if (c > cmax[k]) cmax[k] = c;
+    {
+        int64_t lo0 = SPH__CELL_LIM, lo1 = SPH__CELL_LIM, lo2 = SPH__CELL_LIM;
+        int64_t hi0 = -SPH__CELL_LIM, hi1 = -SPH__CELL_LIM, hi2 = -SPH__CELL_LIM;
+#if defined(_OPENMP) && _OPENMP >= 201107
+#pragma omp parallel for schedule(static) if (n > 2048) reduction(min : lo0, lo1, lo2) \
+    reduction(max : hi0, hi1, hi2)
+#endif
+        for (i = 0; i < (sph__idx)n; ++i) {
+            const sph_real* xi = x + (size_t)i * (size_t)dim;
+            const int64_t c0 = sph__cell_coord(g, 0, xi[0]);
+            const int64_t c1 = dim > 1 ? sph__cell_coord(g, 1, xi[1]) : 0;
+            const int64_t c2 = dim > 2 ? sph__cell_coord(g, 2, xi[2]) : 0;
+            if (c0 < lo0) lo0 = c0;
+            if (c0 > hi0) hi0 = c0;
+            if (c1 < lo1) lo1 = c1;
+            if (c1 > hi1) hi1 = c1;
+            if (c2 < lo2) lo2 = c2;
+            if (c2 > hi2) hi2 = c2;
         }
+        cmin[0] = lo0; cmax[0] = hi0;
+        if (dim > 1) { cmin[1] = lo1; cmax[1] = hi1; }
+        if (dim > 2) { cmin[2] = lo2; cmax[2] = hi2; }
     }
     if (n == 0) for (k = 0; k < dim; ++k) cmin[k] = cmax[k] = 0;
     for (k = 0; k < dim; ++k)
@@ -3784,7 +3802,26 @@ static sph_status sph__check_step_input(sph_world* w, sph_real dt) {
         return sph__fail(w, SPH_ERR_ARG, -1, "step: dt = %g: must be finite and > 0", (double)dt);
     if (w->nphase == 0 && w->n > 0)
         return sph__fail(w, SPH_ERR_ARG, -1, "step: the world has particles but no phase");
-    for (i = 0; i < w->n; ++i) {
+    { /* the common case, all good, checked in parallel (a serial pass was 1 % of a step that a
+         second thread could not share); only a bad world is searched again, serially, for its
+         first bad particle and the message */
+        int bad = 0;
+        sph__idx j;
+#if defined(_OPENMP)
+#pragma omp parallel for schedule(static) reduction(| : bad) if (w->n > 2048)
+#endif
+        for (j = 0; j < (sph__idx)w->n; ++j) {
+            int kk, b = !sph__finite((double)w->rho[j]) || !(w->rho[j] > 0) ||
+                        (w->e && !sph__finite((double)w->e[j]));
+            for (kk = 0; kk < (int)D; ++kk)
+                b |= !sph__finite((double)w->x[(size_t)j * D + (size_t)kk]) |
+                     !sph__finite((double)w->v[(size_t)j * D + (size_t)kk]);
+            bad |= b;
+        }
+        if (!bad) i = w->n; /* skip the serial search below */
+        else i = 0;
+    }
+    for (; i < w->n; ++i) {
         for (k = 0; k < D; ++k) {
             if (!sph__finite((double)w->x[i * D + k]))
                 return sph__fail(w, SPH_ERR_ARG, (long)i,
@@ -3862,7 +3899,10 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
     for (blk = 0; blk < (sph__idx)nblk; ++blk) {
         const size_t i0 = (size_t)blk * SPH__BLOCK;
         const size_t i1 = i0 + SPH__BLOCK < w->n ? i0 + SPH__BLOCK : w->n;
-        double* r = w->priv.block + (size_t)blk * SPH__RED_N;
+        /* the block's sums in a local array (registers), stored once at the end: through the
+           shared array they were stored and reloaded for every particle (the integration took
+           5 ns per particle and pass, and longer on 2 threads) */
+        double r[SPH__RED_N];
         size_t i;
         int kk;
         for (kk = 0; kk < SPH__RED_N; ++kk) r[kk] = 0;
@@ -3919,6 +3959,7 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 r[SPH__RED_KIND] = bad;
             }
         }
+        if (final) memcpy(w->priv.block + (size_t)blk * SPH__RED_N, r, sizeof(r));
     }
     if (!final) return SPH_OK;
     for (k = 0; k < SPH__RED_N; ++k) red[k] = 0;
@@ -4089,13 +4130,26 @@ static void sph__undo_drift(sph_world* w, const sph_real* xn, uint64_t sorts) {
    p_j / rho_j^2 (forces) and m_j / rho_j (delta-SPH), the same expressions, so the same bits.
    A division per pair cost about a fifth of each pass. Only for one mass (the fast path's case)
    and while rho and p stay as they are (symplectic Euler: both passes see rho^n, p^n). */
-static sph_status sph__pair_cache(sph_world* w, sph__ctx* c) {
+/* Exactly the worlds whose passes take sph__interact_one's fast path (sph__stage_interact). */
+static int sph__pair_cache_used(const sph_world* w) {
+    return !w->m && w->nphase == 1 && w->phases[0].viscosity <= 0 && w->kernel.form == SPH__KF_WC2 &&
+           (w->dim == 2 || w->dim == 3) && !w->def.periodic[0] && !w->def.periodic[1] &&
+           !w->def.periodic[2] && w->def.pressure_grad == SPH_PGRAD_SYMMETRIC;
+}
+
+/* Its arrays, reserved before the step changes anything (out of memory then leaves the world as
+   it was; tests/test_oom.c). */
+static sph_status sph__pair_cache_reserve(sph_world* w) {
+    sph_status s = SPH_OK;
+    if (!sph__pair_cache_used(w)) return SPH_OK; /* the fast path does not run: nothing to cache */
+    if ((s = sph__scratch(w, &w->priv.pr2, w->capacity)) == SPH_OK)
+        s = sph__scratch(w, &w->priv.vol, w->capacity);
+    return s;
+}
+
+static void sph__pair_cache(sph_world* w, sph__ctx* c) {
     sph__idx i;
-    sph_status s;
-    if (w->m || w->nphase != 1) return SPH_OK; /* the fast path does not run: nothing to cache */
-    if ((s = sph__scratch(w, &w->priv.pr2, w->capacity)) != SPH_OK ||
-        (s = sph__scratch(w, &w->priv.vol, w->capacity)) != SPH_OK)
-        return s;
+    if (!sph__pair_cache_used(w)) return;
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) {
         w->priv.pr2[i] = w->p[i] / (w->rho[i] * w->rho[i]);
@@ -4103,7 +4157,6 @@ static sph_status sph__pair_cache(sph_world* w, sph__ctx* c) {
     }
     c->pr2c = w->priv.pr2;
     c->volc = w->priv.vol;
-    return SPH_OK;
 }
 
 /* Symplectic Euler (seed 000 sec. 2.3, "semi-implicit"):
@@ -4129,9 +4182,10 @@ static sph_status sph__step_wcsph_euler(sph_world* w, sph_real dt) {
     const int cont = w->def.density != SPH_DENSITY_SUMMATION;
     double t0 = sph__now(), tstart = t0;
     sph__ctx c;
-    sph_status s = sph__prepare_forces(w, &c, w->time, &t0);
-    if (s == SPH_OK) s = sph__pair_cache(w, &c);
+    sph_status s = sph__pair_cache_reserve(w);
+    if (s == SPH_OK) s = sph__prepare_forces(w, &c, w->time, &t0);
     if (s != SPH_OK) return s;
+    sph__pair_cache(w, &c);
     sph__stage_interact(w, &c, SPH__ACCEL, w->a);
     sph__time(w, SPH_STAGE_FORCES, &t0);
     s = sph__integrate(w, &c, dt, 0, 0, 0); /* kick */
