@@ -27,7 +27,7 @@ B        = build
 TEST_SRC = tests/main.c tests/impl.c tests/test_kernels.c tests/test_grid.c tests/test_operators.c \
            tests/test_world.c tests/test_wcsph.c tests/test_pcisph.c tests/test_iisph.c \
            tests/test_compressible.c tests/test_soc.c tests/test_io.c tests/test_save.c \
-           tests/test_reliability.c tests/test_oom.c \
+           tests/test_reliability.c tests/test_oom.c tests/test_validation.c \
            tests/test_compile.c \
            tests/compile_second.c \
            tests/compile_static.c
@@ -72,6 +72,23 @@ $(B)/bench: $(BENCH_SRC) bench/bench_core.h bench/bench_types.h bench/baseline.h
 
 $(B)/convergence: bench/convergence.c sph.h examples/scenes.h bench/svg.h | $(B)
 	$(CC) $(CFLAGS) $(OMP) -I. bench/convergence.c -o $@ -lm
+
+# make pareto: speed against accuracy per solver on the dam break, hydrostatic tank and Re 100
+# cavity, and the stability maps (bench/pareto.c), CSV and SVG into bench/results/. One thread
+# (CPU seconds are compared); the log (kinetic energy of the cavity runs, the messages of runs
+# that failed) in bench/results/pareto.txt. make pareto-quick: fewer runs into out/pareto-quick/
+# (about 30 s on 2 cores).
+.PHONY: pareto pareto-quick
+pareto: $(B)/pareto
+	mkdir -p bench/results
+	OMP_NUM_THREADS=1 ./$(B)/pareto bench/results > bench/results/pareto.txt 2>&1; st=$$?; cat bench/results/pareto.txt; exit $$st
+
+pareto-quick: $(B)/pareto
+	mkdir -p out/pareto-quick
+	OMP_NUM_THREADS=1 ./$(B)/pareto --quick out/pareto-quick
+
+$(B)/pareto: bench/pareto.c sph.h examples/scenes.h bench/svg.h | $(B)
+	$(CC) $(CFLAGS) $(OMP) -I. bench/pareto.c -o $@ -lm
 
 demo: $(B)/dambreak
 	./$(B)/dambreak

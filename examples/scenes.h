@@ -342,4 +342,124 @@ static const double scene_mm_Z[] = {1.11, 1.22, 1.44, 1.67, 1.89, 2.11, 2.33, 2.
 /* Time [s] of Martin & Moyce's nondimensional time T for column width a [m]. */
 SCENE_FN double scene_mm_time(double T, double a) { return T / sqrt(2 * 9.81 / a); }
 
+/* Lid-driven cavity (Ghia, Ghia & Shin 1982; validation-data.md sec. 2): fluid of rest density
+   1 kg/m^3 filling the unit square, no gravity, kinematic viscosity nu = U L / Re [m^2/s] with
+   U = SCENE_CAVITY_U = 1 m/s and L = 1 m, sound speed 10 U (PySPH's cavity.py), no-slip walls
+   (Adami's extrapolated wall velocity). Body 0 is the fixed box (bottom and sides), body 1 the
+   lid above y = 1, spanning the side walls' layers so the top corners are closed; the lid keeps
+   its position and moves tangentially at u = U through scene_cavity_lid, the motion callback
+   (a moving wall enters the no-slip viscous terms and IISPH's source only through b_v).
+   `res` particles over the side. */
+#define SCENE_CAVITY_U 1.0
+
+SCENE_FN void scene_cavity_lid(sph_world* w, double t, void* user) {
+    size_t b;
+    int k;
+    (void)t;
+    (void)user;
+    for (b = 0; b < w->nb; ++b) {
+        if (w->b_body[b] != 1) continue;
+        for (k = 0; k < w->dim; ++k) {
+            w->b_x[b * (size_t)w->dim + (size_t)k] = w->b_x0[b * (size_t)w->dim + (size_t)k];
+            w->b_v[b * (size_t)w->dim + (size_t)k] = (sph_real)(k == 0 ? SCENE_CAVITY_U : 0);
+            w->b_a[b * (size_t)w->dim + (size_t)k] = 0;
+        }
+    }
+}
+
+SCENE_FN sph_status scene_cavity(sph_world* w, sph_world_def def, int res, double Re) {
+    sph_real lo[2] = {0, 0}, hi[2] = {1, 1}, *pts;
+    sph_phase fluid;
+    int ph, layers, i, j, m;
+    size_t n = 0;
+    def.dim = 2;
+    def.spacing = (sph_real)(1.0 / res);
+    def.gravity[0] = def.gravity[1] = def.gravity[2] = 0;
+    def.wall = SPH_WALL_NO_SLIP;
+    def.boundary_motion = scene_cavity_lid;
+    def.boundary_user = NULL;
+    memset(&fluid, 0, sizeof(fluid));
+    fluid.rest_density = 1;
+    fluid.sound_speed = (sph_real)(10 * SCENE_CAVITY_U);
+    fluid.viscosity = (sph_real)(SCENE_CAVITY_U * 1.0 / Re);
+    SCENE__TRY(sph_world_init(w, &def));
+    ph = sph_world_add_phase(w, &fluid);
+    if (ph < 0) return scene__fail(w, w->status);
+    SCENE__TRY(sph_fill_box(w, ph, lo, hi));
+    SCENE__TRY(sph_add_wall_box(w, lo, hi, 0, SPH_FACE_YMAX));
+    layers = (int)ceil((double)(w->kernel.radius / w->dx) - 1e-9); /* as sph_add_wall_box */
+    m = res + 2 * layers;
+    pts = (sph_real*)malloc((size_t)(m * layers) * 2 * sizeof(sph_real));
+    if (!pts) return scene__fail(w, SPH_ERR_NOMEM);
+    for (j = 0; j < layers; ++j)
+        for (i = 0; i < m; ++i) {
+            pts[2 * n] = (sph_real)((i - layers + 0.5) * (double)w->dx);
+            pts[2 * n + 1] = (sph_real)(1 + (j + 0.5) * (double)w->dx);
+            ++n;
+        }
+    if (sph_add_boundary(w, n, pts, NULL, 1) != SPH_OK) { free(pts); return scene__fail(w, w->status); }
+    free(pts);
+    scene_cavity_lid(w, 0, NULL); /* so that sph_stable_dt sees the lid speed before step 1 */
+    return SPH_OK;
+}
+
+/* Ghia, Ghia & Shin 1982, J. Comput. Phys. 48, 387-411, Re = 100: Table I, u along the vertical
+   centre line x = 0.5 (at y = scene_ghia_y), and Table II, v along the horizontal centre line
+   y = 0.5 (at x = scene_ghia_x); unit cavity, lid u = 1 at y = 1 (validation-data.md sec. 2). */
+#define SCENE_GHIA_N 17
+static const double scene_ghia_y[] = {1.0000, 0.9766, 0.9688, 0.9609, 0.9531, 0.8516,
+                                       0.7344, 0.6172, 0.5000, 0.4531, 0.2813, 0.1719,
+                                       0.1016, 0.0703, 0.0625, 0.0547, 0.0000};
+static const double scene_ghia_u100[] = {1.0000,   0.84123,  0.78871,  0.73722,  0.68717,
+                                          0.23151,  0.00332,  -0.13641, -0.20581, -0.21090,
+                                          -0.15662, -0.10150, -0.06434, -0.04775, -0.04192,
+                                          -0.03717, 0.00000};
+static const double scene_ghia_x[] = {1.0000, 0.9688, 0.9609, 0.9531, 0.9453, 0.9063,
+                                       0.8594, 0.8047, 0.5000, 0.2344, 0.2266, 0.1563,
+                                       0.0938, 0.0781, 0.0703, 0.0625, 0.0000};
+static const double scene_ghia_v100[] = {0.00000,  -0.05906, -0.07391, -0.08864, -0.10313,
+                                          -0.16914, -0.22445, -0.24533, 0.05454,  0.17527,
+                                          0.17507,  0.16077,  0.12317,  0.10890,  0.10091,
+                                          0.09233,  0.00000};
+
+/* Two-layer tank (validation-data.md sec. 4; seed 000 sec. 5.3): scene_hydrostatic's tank with
+   water (rho0 = 1000 kg/m^3) below depth/2 and a phase of rest density ratio * rho0 above, up
+   to `depth` [m], `res` particles over the depth, both at the same spacing (so the particle
+   masses differ by the ratio), initialised in hydrostatic equilibrium. Phase 0 is the water.
+   scene_two_layer_p gives the exact pressure [Pa] at height y [m] for gravity g [m/s^2]. */
+SCENE_FN sph_status scene_two_layer(sph_world* w, sph_world_def def, double width, double depth,
+                                    int res, double ratio) {
+    sph_real lo[2] = {0, 0}, hi[2], whi[2];
+    sph_phase heavy, light;
+    int a, b;
+    def.dim = 2;
+    def.spacing = (sph_real)(depth / res);
+    hi[0] = whi[0] = (sph_real)width;
+    hi[1] = (sph_real)(depth / 2);
+    whi[1] = (sph_real)(1.4 * depth);
+    memset(&heavy, 0, sizeof(heavy));
+    memset(&light, 0, sizeof(light));
+    heavy.rest_density = 1000;
+    light.rest_density = (sph_real)(1000 * ratio);
+    SCENE__TRY(sph_world_init(w, &def));
+    a = sph_world_add_phase(w, &heavy);
+    b = sph_world_add_phase(w, &light);
+    if (a < 0 || b < 0) return scene__fail(w, w->status);
+    SCENE__TRY(sph_fill_box(w, a, lo, hi));
+    lo[1] = hi[1];
+    hi[1] = (sph_real)depth;
+    SCENE__TRY(sph_fill_box(w, b, lo, hi));
+    lo[1] = 0;
+    SCENE__TRY(sph_add_wall_box(w, lo, whi, 0, SPH_FACE_YMAX));
+    SCENE__TRY(sph_set_hydrostatic(w));
+    return SPH_OK;
+}
+
+/* p = rho1 g (H - y) above the interface H/2, rho1 g H/2 + rho0 g (H/2 - y) below it
+   (validation-data.md sec. 4), rho0 = 1000, rho1 = ratio rho0. */
+SCENE_FN double scene_two_layer_p(double y, double depth, double ratio, double g) {
+    const double r0 = 1000, r1 = 1000 * ratio, H = depth;
+    return y > H / 2 ? r1 * g * (H - y) : r1 * g * H / 2 + r0 * g * (H / 2 - y);
+}
+
 #endif
