@@ -9,6 +9,8 @@
 #   make bench     the benchmark driver (bench/bench.c: speed against a baseline, scaling, memory,
 #                  cost growth) and the Taylor-Green convergence study, results in bench/results/
 #   make bench-quick  the driver at small sizes (under a minute), into out/bench-quick/
+#   make pareto    error against CPU time per solver and scene, stability maps (bench/pareto.c,
+#                  about 11 minutes), into bench/results/; make pareto-quick: small, out/pareto-quick/
 #   make paraview  the dam break as a ParaView time series: out/paraview/dambreak.pvd
 #   make realtime  the interactive SDL2 demo (optional; needs libsdl2-dev)
 #   make install   sph.h and sph.pc (pkg-config) under PREFIX (default /usr/local); CMake users
