@@ -781,9 +781,9 @@ typedef struct sph__private {
     size_t aii_cap, src_cap, ap_cap;
     sph_real *ff_fw, *fb_fw;        /* iterative solvers: grad W_ij / x_ij per listed pair          */
     size_t ff_fw_cap, fb_fw_cap;
-    sph_real* pr2;                  /* iterative solvers, WCSPH: p_i / rho_i^2 (scratch)            */
+    sph_real* pr2;                  /* iterative solvers, WCSPH: p_i / rho_i^2 (scratch)          */
     size_t pr2_cap;
-    sph_real* vol;                  /* WCSPH: m_i / rho_i (scratch)                                 */
+    sph_real* vol;                  /* WCSPH: m_i / rho_i (scratch)                               */
     size_t vol_cap;
     sph_real *xp, *vp;              /* PCISPH: predicted positions and velocities (scratch)         */
     size_t xp_cap, vp_cap;
@@ -2870,7 +2870,8 @@ SPHDEF size_t sph_world_memory(const sph_world* w) {
              sph__neighbors_memory(&w->priv.snl);
     bytes += w->priv.perm_cap + w->priv.block_cap * sizeof(double) +
              (w->priv.rho_n_cap + w->priv.aii_cap + w->priv.src_cap + w->priv.ap_cap +
-              w->priv.ff_fw_cap + w->priv.fb_fw_cap + w->priv.pr2_cap + w->priv.vol_cap + w->priv.xp_cap +
+              w->priv.ff_fw_cap + w->priv.fb_fw_cap + w->priv.pr2_cap + w->priv.vol_cap +
+              w->priv.xp_cap +
               w->priv.vp_cap + w->priv.de_cap + w->priv.cs_cap + w->priv.vn_cap + w->priv.bpq_cap + w->priv.soc_cap + w->priv.socw_cap) *
                  sizeof(sph_real);
     return bytes;
@@ -3079,7 +3080,8 @@ SPH__INLINE void sph__delta_vec(const sph__ctx* c, const sph_real* a, const sph_
 SPH__INLINE void sph__delta_vec_p(const sph__ctx* c, const int per, const sph_real* a,
                                   const sph_real* b, sph_real* d, const int D) {
     int k;
-    SPH__FOR_K(D, d[k] = a[k] - b[k]; if (per && c->per[k]) d[k] = sph__wrap_delta(d[k], c->len[k]));
+    SPH__FOR_K(D, d[k] = a[k] - b[k];
+               if (per && c->per[k]) d[k] = sph__wrap_delta(d[k], c->len[k]));
 }
 
 /* Wall particles see their fluid neighbours f through Shepard averages (weights W_bf / sum_f W_bf).
@@ -3617,7 +3619,8 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
         const sph_real* vj = c->v + j * (size_t)D;
         const sph_real* uj = en ? c->vn + j * (size_t)D : vj;
         const sph_real mj = cm ? cm[j] : c->m0, rhoj = c->rho[j];
-        const sph__phase_c* Pj = (flags & (SPH__VISCOUS | SPH__RATE)) && !fast ? &c->pc[c->ph[j]] : P;
+        const sph__phase_c* Pj =
+            (flags & (SPH__VISCOUS | SPH__RATE)) && !fast ? &c->pc[c->ph[j]] : P;
         sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, ud = 0, fw, s = 0, lm = 0;
         sph__delta_vec_p(c, per, xi, xj, d, D);
         SPH__FOR_K(D, r2 += d[k] * d[k]);
@@ -3676,7 +3679,8 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
             const sph_real* vb = c->bv + b * (size_t)D;
             const sph_real Vb = c->bvol[b], psi = P->rho0 * Vb;
             /* the wall's density and pressure as the boundary scheme gives them */
-            const sph_real* bq = bpqa ? bpqa + ((size_t)b * (size_t)c->nphase + c->ph[i]) * 2 : NULL;
+            const sph_real* bq =
+                bpqa ? bpqa + ((size_t)b * (size_t)c->nphase + c->ph[i]) * 2 : NULL;
             const sph_real kap = bq ? bq[1] : c->bp_mode == SPH_BP_EXTRAPOLATE ? c->brho[b] : rhati;
             const sph_real rhob = P->rho0 * kap;
             sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, ud = 0, fw, s = 0, lm = 0, ug = 0;
@@ -3753,7 +3757,8 @@ static void sph__stage_interact(sph_world* w, const sph__ctx* c, int flags, sph_
         const size_t i0 = (size_t)blk * SPH__BLOCK;
         const size_t i1 = i0 + SPH__BLOCK < w->n ? i0 + SPH__BLOCK : w->n;
         size_t i;
-#define SPH__LOOP(D, FL, F) for (i = i0; i < i1; ++i) sph__interact_one(c, i, D, FL, acc, w->drho, F)
+#define SPH__LOOP(D, FL, F)                                                                        \
+    for (i = i0; i < i1; ++i) sph__interact_one(c, i, D, FL, acc, w->drho, F)
 #define SPH__CASES(D, F)                                                                           \
     case (F) * 256 + D * 64 + SPH__ACCEL: SPH__LOOP(D, SPH__ACCEL, F); break;                      \
     case (F) * 256 + D * 64 + SPH__VISCOUS: SPH__LOOP(D, SPH__VISCOUS, F); break;                  \
@@ -4133,11 +4138,12 @@ static void sph__undo_drift(sph_world* w, const sph_real* xn, uint64_t sorts) {
 /* ============================================================================================== */
 /* Per-particle factors the fast-path passes would otherwise divide out for every pair:
    p_j / rho_j^2 (forces) and m_j / rho_j (delta-SPH), the same expressions, so the same bits.
-   Measured at 100k particles in 2D: the density-rate pass 10 % and the force pass 6 % faster. Only for one mass (the fast path's case)
-   and while rho and p stay as they are (symplectic Euler: both passes see rho^n, p^n). */
-/* Exactly the worlds whose passes take sph__interact_one's fast path (sph__stage_interact). */
+   Measured at 100k particles in 2D: the density-rate pass 10 % and the force pass 6 % faster.
+   Only while rho and p stay as they are (symplectic Euler: both passes see rho^n, p^n), and for
+   exactly the worlds whose passes take sph__interact_one's fast path (sph__stage_interact). */
 static int sph__pair_cache_used(const sph_world* w) {
-    return !w->m && w->nphase == 1 && w->phases[0].viscosity <= 0 && w->kernel.form == SPH__KF_WC2 &&
+    return !w->m && w->nphase == 1 && w->phases[0].viscosity <= 0 &&
+           w->kernel.form == SPH__KF_WC2 &&
            (w->dim == 2 || w->dim == 3) && !w->def.periodic[0] && !w->def.periodic[1] &&
            !w->def.periodic[2] && w->def.pressure_grad == SPH_PGRAD_SYMMETRIC;
 }

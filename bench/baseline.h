@@ -29,16 +29,16 @@ typedef struct base_grid {
     int dim, ext[3];
     sph_real lo[3], cell;
     size_t ncell, cap_cell, cap_n;
-    uint32_t* start; /* [ncell + 1] */
-    uint32_t* item;  /* [n] particle indices, grouped by cell */
+    uint32_t* start;   /* [ncell + 1] */
+    uint32_t* item;    /* [n] particle indices, grouped by cell */
     uint32_t* cell_of; /* [n] */
 } base_grid;
 
 typedef struct base_world {
     int dim;
     size_t n, nb;
-    sph_real *x, *v, *rho, *p, *a, *drho;  /* fluid, x[i*dim + k] */
-    sph_real *bx, *bvol, *bp, *bkap;         /* walls: position, volume, pressure, rho_b/rho0 */
+    sph_real *x, *v, *rho, *p, *a, *drho; /* fluid, x[i*dim + k] */
+    sph_real *bx, *bvol, *bp, *bkap;      /* walls: position, volume, pressure, rho_b/rho0 */
     uint32_t* id;
     base_grid gf, gb;
     uint32_t *ff, *ffn, *fb, *fbn, *bf, *bfn; /* neighbour rows of BASE_MAXNB */
@@ -57,14 +57,30 @@ static double base__now(void) {
 }
 
 static void base__grid_free(base_grid* g) {
-    free(g->start); free(g->item); free(g->cell_of);
+    free(g->start);
+    free(g->item);
+    free(g->cell_of);
     memset(g, 0, sizeof(*g));
 }
 
 static void base_free(base_world* b) {
-    free(b->x); free(b->v); free(b->rho); free(b->p); free(b->a); free(b->drho);
-    free(b->bx); free(b->bvol); free(b->bp); free(b->bkap); free(b->id);
-    free(b->ff); free(b->ffn); free(b->fb); free(b->fbn); free(b->bf); free(b->bfn);
+    free(b->x);
+    free(b->v);
+    free(b->rho);
+    free(b->p);
+    free(b->a);
+    free(b->drho);
+    free(b->bx);
+    free(b->bvol);
+    free(b->bp);
+    free(b->bkap);
+    free(b->id);
+    free(b->ff);
+    free(b->ffn);
+    free(b->fb);
+    free(b->fbn);
+    free(b->bf);
+    free(b->bfn);
     base__grid_free(&b->gf);
     base__grid_free(&b->gb);
     memset(b, 0, sizeof(*b));
@@ -76,7 +92,8 @@ static int base_init(base_world* b, const sph_world* w) {
     const sph_phase* P = &w->phases[0];
     int k;
     memset(b, 0, sizeof(*b));
-    if (w->nphase != 1 || P->gamma != 7 || w->def.kernel != SPH_KERNEL_WENDLAND_C2 || w->m) return 0;
+    if (w->nphase != 1 || P->gamma != 7 || w->def.kernel != SPH_KERNEL_WENDLAND_C2 || w->m)
+        return 0;
     b->dim = w->dim;
     b->n = w->n;
     b->nb = w->nb;
@@ -96,7 +113,10 @@ static int base_init(base_world* b, const sph_world* w) {
     b->ffn = (uint32_t*)calloc(b->n + 1, sizeof(uint32_t));
     b->fbn = (uint32_t*)calloc(b->n + 1, sizeof(uint32_t));
     b->bfn = (uint32_t*)calloc(b->nb + 1, sizeof(uint32_t));
-    if (!b->id || !b->ff || !b->fb || !b->bf || !b->ffn || !b->fbn || !b->bfn) { base_free(b); return 0; }
+    if (!b->id || !b->ff || !b->fb || !b->bf || !b->ffn || !b->fbn || !b->bfn) {
+        base_free(b);
+        return 0;
+    }
     memcpy(b->x, w->x, b->n * D * sizeof(sph_real));
     memcpy(b->v, w->v, b->n * D * sizeof(sph_real));
     memcpy(b->rho, w->rho, b->n * sizeof(sph_real));
@@ -118,7 +138,8 @@ static int base_init(base_world* b, const sph_world* w) {
     b->alpha = w->def.alpha;
     b->delta = w->def.delta;
     b->eta2 = (sph_real)0.01 * w->h * w->h;
-    for (k = 0; k < 3; ++k) b->g[k] = k < w->dim ? w->def.gravity[k] : 0;
+    for (k = 0; k < 3; ++k)
+        b->g[k] = k < w->dim ? w->def.gravity[k] : 0;
     return 1;
 }
 
@@ -140,8 +161,15 @@ static int base__grid_build(base_grid* g, int dim, const sph_real* x, size_t n, 
     int k;
     g->dim = dim;
     g->cell = R;
-    for (k = 0; k < 3; ++k) { g->lo[k] = 0; hi[k] = 0; g->ext[k] = 1; }
-    for (k = 0; k < dim; ++k) { g->lo[k] = n ? x[k] : 0; hi[k] = g->lo[k]; }
+    for (k = 0; k < 3; ++k) {
+        g->lo[k] = 0;
+        hi[k] = 0;
+        g->ext[k] = 1;
+    }
+    for (k = 0; k < dim; ++k) {
+        g->lo[k] = n ? x[k] : 0;
+        hi[k] = g->lo[k];
+    }
     for (i = 0; i < n; ++i)
         for (k = 0; k < dim; ++k) {
             const sph_real v = x[i * (size_t)dim + (size_t)k];
@@ -160,7 +188,8 @@ static int base__grid_build(base_grid* g, int dim, const sph_real* x, size_t n, 
         if (!g->start) return 0;
     }
     if (n > g->cap_n) {
-        free(g->item); free(g->cell_of);
+        free(g->item);
+        free(g->cell_of);
         g->item = (uint32_t*)malloc(n * sizeof(uint32_t));
         g->cell_of = (uint32_t*)malloc(n * sizeof(uint32_t));
         g->cap_n = (g->item && g->cell_of) ? n : 0;
@@ -175,9 +204,12 @@ static int base__grid_build(base_grid* g, int dim, const sph_real* x, size_t n, 
         g->cell_of[i] = (uint32_t)cell;
         g->start[cell + 1]++;
     }
-    for (c = 0; c < g->ncell; ++c) g->start[c + 1] += g->start[c];
-    for (i = 0; i < n; ++i) g->item[g->start[g->cell_of[i]]++] = (uint32_t)i;
-    for (c = g->ncell; c > 0; --c) g->start[c] = g->start[c - 1]; /* undo the shift */
+    for (c = 0; c < g->ncell; ++c)
+        g->start[c + 1] += g->start[c];
+    for (i = 0; i < n; ++i)
+        g->item[g->start[g->cell_of[i]]++] = (uint32_t)i;
+    for (c = g->ncell; c > 0; --c)
+        g->start[c] = g->start[c - 1]; /* undo the shift */
     g->start[0] = 0;
     return 1;
 }
@@ -217,8 +249,10 @@ static void base__lists(base_world* b, const base_grid* g, const sph_real* y, co
                             r2 += d * d;
                         }
                         if (r2 < R2) {
-                            if (count < BASE_MAXNB) out[(size_t)i * BASE_MAXNB + count] = j;
-                            else overflow = 1;
+                            if (count < BASE_MAXNB)
+                                out[(size_t)i * BASE_MAXNB + count] = j;
+                            else
+                                overflow = 1;
                             ++count;
                         }
                     }
@@ -244,21 +278,26 @@ static int base_step(base_world* b, sph_real dt) {
     /* grids and lists, from scratch */
     if (!base__grid_build(&b->gf, D, b->x, n, b->R)) return 0;
     if (nb && !base__grid_build(&b->gb, D, b->bx, nb, b->R)) return 0;
-    t1 = base__now(); b->t_grid += t1 - t0; t0 = t1;
+    t1 = base__now();
+    b->t_grid += t1 - t0;
+    t0 = t1;
     base__lists(b, &b->gf, b->x, b->x, n, 1, b->ff, b->ffn);
     if (nb) {
         base__lists(b, &b->gb, b->bx, b->x, n, 0, b->fb, b->fbn);
         base__lists(b, &b->gf, b->x, b->bx, nb, 0, b->bf, b->bfn);
     }
-    t1 = base__now(); b->t_lists += t1 - t0; t0 = t1;
+    t1 = base__now();
+    b->t_lists += t1 - t0;
+    t0 = t1;
     if (b->overflow) return 0;
-    /* pressure (Tait, gamma = 7) and body acceleration */
+        /* pressure (Tait, gamma = 7) and body acceleration */
 #pragma omp parallel for schedule(static)
     for (i = 0; i < (long)n; ++i) {
         const sph_real t = b->rho[i] / b->rho0;
         int k;
         b->p[i] = b->B * ((sph_real)pow((double)t, 7.0) - 1) + b->pback;
-        for (k = 0; k < D; ++k) b->a[(size_t)i * (size_t)D + (size_t)k] = b->g[k];
+        for (k = 0; k < D; ++k)
+            b->a[(size_t)i * (size_t)D + (size_t)k] = b->g[k];
     }
     /* wall pressure: Adami et al. 2012 eq. 27 (static walls), wall density from eq. 28 */
 #pragma omp parallel for schedule(static)
@@ -270,18 +309,22 @@ static int base_step(base_world* b, sph_real dt) {
             sph_real d[3] = {0, 0, 0}, r2 = 0, W;
             int k;
             for (k = 0; k < D; ++k) {
-                d[k] = b->bx[(size_t)i * (size_t)D + (size_t)k] - b->x[(size_t)f * (size_t)D + (size_t)k];
+                d[k] = b->bx[(size_t)i * (size_t)D + (size_t)k] -
+                       b->x[(size_t)f * (size_t)D + (size_t)k];
                 r2 += d[k] * d[k];
             }
             W = base__W(b, (sph_real)sqrt((double)r2));
             sw += W;
             swp += b->p[f] * W;
-            for (k = 0; k < D; ++k) sgx += b->rho[f] * b->a[(size_t)f * (size_t)D + (size_t)k] * d[k] * W;
+            for (k = 0; k < D; ++k)
+                sgx += b->rho[f] * b->a[(size_t)f * (size_t)D + (size_t)k] * d[k] * W;
         }
         b->bp[i] = sw > 0 ? (swp + sgx) / sw : 0;
         b->bkap[i] = sw > 0 ? base__kap(b, b->bp[i]) : 1;
     }
-    t1 = base__now(); b->t_other += t1 - t0; t0 = t1;
+    t1 = base__now();
+    b->t_other += t1 - t0;
+    t0 = t1;
     /* forces: pressure (symmetric form) and artificial viscosity; walls without viscosity */
 #pragma omp parallel for schedule(static)
     for (i = 0; i < (long)n; ++i) {
@@ -305,7 +348,8 @@ static int base_step(base_world* b, sph_real dt) {
                 const sph_real mu = b->h * vd / (r2 + b->eta2);
                 s -= b->m * (-b->alpha * b->c0 * mu) * 2 / (b->rho[i] + b->rho[j]);
             }
-            for (k = 0; k < D; ++k) ai[k] += s * F * d[k];
+            for (k = 0; k < D; ++k)
+                ai[k] += s * F * d[k];
         }
         for (q = 0; q < b->fbn[i]; ++q) {
             const uint32_t j = b->fb[(size_t)i * BASE_MAXNB + q];
@@ -316,14 +360,20 @@ static int base_step(base_world* b, sph_real dt) {
                 r2 += d[k] * d[k];
             }
             s = -psi * (pi_r2 + b->bp[j] / (rhob * rhob)) * base__F(b, (sph_real)sqrt((double)r2));
-            for (k = 0; k < D; ++k) ai[k] += s * d[k];
+            for (k = 0; k < D; ++k)
+                ai[k] += s * d[k];
         }
-        for (k = 0; k < D; ++k) b->a[(size_t)i * (size_t)D + (size_t)k] += ai[k];
+        for (k = 0; k < D; ++k)
+            b->a[(size_t)i * (size_t)D + (size_t)k] += ai[k];
     }
-    t1 = base__now(); b->t_forces += t1 - t0; t0 = t1;
+    t1 = base__now();
+    b->t_forces += t1 - t0;
+    t0 = t1;
 #pragma omp parallel for schedule(static)
-    for (i = 0; i < (long)(n * (size_t)D); ++i) b->v[i] += dt * b->a[i]; /* kick */
-    /* density rate: continuity with the new velocities, plus delta-SPH (Molteni & Colagrossi) */
+    for (i = 0; i < (long)(n * (size_t)D); ++i)
+        b->v[i] += dt * b->a[i]; /* kick */
+        /* density rate: continuity with the new velocities, plus delta-SPH (Molteni & Colagrossi)
+         */
 #pragma omp parallel for schedule(static)
     for (i = 0; i < (long)n; ++i) {
         const sph_real* xi = b->x + (size_t)i * (size_t)D;
@@ -342,7 +392,8 @@ static int base_step(base_world* b, sph_real dt) {
             }
             F = base__F(b, (sph_real)sqrt((double)r2));
             R += b->m * F * vd;
-            R += dcoef * (b->m / b->rho[j]) * (rhati - b->rho[j] / b->rho0) * F * r2 / (r2 + b->eta2);
+            R += dcoef * (b->m / b->rho[j]) * (rhati - b->rho[j] / b->rho0) * F * r2 /
+                 (r2 + b->eta2);
         }
         for (q = 0; q < b->fbn[i]; ++q) {
             const uint32_t j = b->fb[(size_t)i * BASE_MAXNB + q];
@@ -358,7 +409,9 @@ static int base_step(base_world* b, sph_real dt) {
         }
         b->drho[i] = R;
     }
-    t1 = base__now(); b->t_density += t1 - t0; t0 = t1;
+    t1 = base__now();
+    b->t_density += t1 - t0;
+    t0 = t1;
 #pragma omp parallel for schedule(static)
     for (i = 0; i < (long)n; ++i) { /* density and drift */
         int k;
@@ -366,17 +419,18 @@ static int base_step(base_world* b, sph_real dt) {
         for (k = 0; k < D; ++k)
             b->x[(size_t)i * (size_t)D + (size_t)k] += dt * b->v[(size_t)i * (size_t)D + (size_t)k];
     }
-    t1 = base__now(); b->t_other += t1 - t0;
+    t1 = base__now();
+    b->t_other += t1 - t0;
     return 1;
 }
 
 /* bytes per fluid particle held by the baseline (lists at their fixed capacity) */
 static double base_bytes_per_particle(const base_world* b) {
     const double D = b->dim;
-    double bytes = (double)b->n * ((3 * D + 4) * sizeof(sph_real) + 4 + 2 * 4 + 2 * BASE_MAXNB * 4.0 +
-                                   2 * 4) +
-                   (double)b->nb * ((D + 3) * sizeof(sph_real) + BASE_MAXNB * 4.0 + 4 + 2 * 4) +
-                   4.0 * (double)(b->gf.cap_cell + b->gb.cap_cell);
+    double bytes =
+        (double)b->n * ((3 * D + 4) * sizeof(sph_real) + 4 + 2 * 4 + 2 * BASE_MAXNB * 4.0 + 2 * 4) +
+        (double)b->nb * ((D + 3) * sizeof(sph_real) + BASE_MAXNB * 4.0 + 4 + 2 * 4) +
+        4.0 * (double)(b->gf.cap_cell + b->gb.cap_cell);
     return bytes / (double)b->n;
 }
 

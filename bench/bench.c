@@ -71,7 +71,10 @@ static FILE* csv_open(const opts* o, const char* name, const char* header) {
     FILE* f;
     snprintf(path, sizeof path, "%s/%s", o->out, name);
     f = fopen(path, "w");
-    if (!f) { fprintf(stderr, "bench: cannot write %s\n", path); return NULL; }
+    if (!f) {
+        fprintf(stderr, "bench: cannot write %s\n", path);
+        return NULL;
+    }
     fprintf(f, "%s\n", header);
     return f;
 }
@@ -99,7 +102,8 @@ typedef struct med_run {
 static bench_result med_pick(med_run* m) {
     double t[16];
     int k;
-    for (k = 0; k < m->n; ++k) t[k] = m->r[k].step_s;
+    for (k = 0; k < m->n; ++k)
+        t[k] = m->r[k].step_s;
     {
         const double md = median(t, m->n);
         int best = 0;
@@ -134,18 +138,24 @@ static int suite_throughput(const opts* o) {
         memset(&base, 0, sizeof base);
         memset(runs, 0, sizeof runs);
         for (rep = 0; rep < o->repeats; ++rep) {
-            const int steps = o->steps ? o->steps : steps_for(n, solver_cost[0] * (dim == 3 ? 4 : 1), budget, 5, 200);
+            const int steps =
+                o->steps ? o->steps
+                         : steps_for(n, solver_cost[0] * (dim == 3 ? 4 : 1), budget, 5, 200);
             if (!run_baseline_d(sc, n, 5, steps, &base.r[base.n++])) return 0;
             for (k = 0; k < BENCH_NSOLVER; ++k) {
-                const int sk = o->steps ? o->steps : steps_for(n, solver_cost[k] * (dim == 3 ? 4 : 1), budget, 3, 200);
+                const int sk =
+                    o->steps ? o->steps
+                             : steps_for(n, solver_cost[k] * (dim == 3 ? 4 : 1), budget, 3, 200);
                 if (failed[k]) continue;
-                if (!run_d(sc, k, n, 5, sk, &runs[k].r[runs[k].n])) failed[k] = 1; /* reported below */
-                else runs[k].n++;
+                if (!run_d(sc, k, n, 5, sk, &runs[k].r[runs[k].n]))
+                    failed[k] = 1; /* reported below */
+                else
+                    runs[k].n++;
             }
         }
         b = med_pick(&base);
-        printf("%s (%s): %.0f fluid + %.0f wall particles, %.1f pairs/particle\n", bench_scenes[sc].name,
-               bench_scenes[sc].what, b.n, b.nb, runs[0].r[0].pairs);
+        printf("%s (%s): %.0f fluid + %.0f wall particles, %.1f pairs/particle\n",
+               bench_scenes[sc].name, bench_scenes[sc].what, b.n, b.nb, runs[0].r[0].pairs);
         printf("  %-12s %10s %14s %8s %10s %9s %11s\n", "solver", "ms/step", "particle-st/s",
                "iters", "ms/iter", "vs base", "search ms");
         printf("  %-12s %10.3f %14.3g %8s %10s %9s %11.3f   (agrees with sph.h to %.1e dx)\n",
@@ -160,7 +170,8 @@ static int suite_throughput(const opts* o) {
             const double* st;
             if (failed[k]) {
                 printf("  %-12s failed (the step error is printed above)\n", bench_solvers[k].name);
-                fprintf(f, "%s,%s,1,,,,,,,,,,,,,,,\n", bench_scenes[sc].name, bench_solvers[k].name);
+                fprintf(f, "%s,%s,1,,,,,,,,,,,,,,,\n", bench_scenes[sc].name,
+                        bench_solvers[k].name);
                 continue;
             }
             r[k] = med_pick(&runs[k]);
@@ -169,13 +180,15 @@ static int suite_throughput(const opts* o) {
                    1e3 * r[k].step_s, r[k].n / r[k].step_s, r[k].iterations,
                    r[k].iterations > 0 ? 1e3 * r[k].step_s / r[k].iterations : 0,
                    b.step_s / r[k].step_s, 1e3 * st[SPH_STAGE_NEIGHBORS]);
-            fprintf(f, "%s,%s,1,%.0f,%.0f,%.6f,%.6g,%.2f,%.6f,%.3f,%.6f,%.6f,%.6f,%.6f,%.6f,%.2f,%.1f,\n",
-                    bench_scenes[sc].name, bench_solvers[k].name, r[k].n, r[k].nb,
-                    1e3 * r[k].step_s, r[k].n / r[k].step_s, r[k].iterations,
-                    r[k].iterations > 0 ? 1e3 * r[k].step_s / r[k].iterations : 0,
-                    b.step_s / r[k].step_s, 1e3 * st[SPH_STAGE_NEIGHBORS], 1e3 * st[SPH_STAGE_DENSITY],
-                    1e3 * st[SPH_STAGE_PRESSURE], 1e3 * st[SPH_STAGE_FORCES],
-                    1e3 * st[SPH_STAGE_INTEGRATE], r[k].pairs, r[k].bytes);
+            fprintf(
+                f,
+                "%s,%s,1,%.0f,%.0f,%.6f,%.6g,%.2f,%.6f,%.3f,%.6f,%.6f,%.6f,%.6f,%.6f,%.2f,%.1f,\n",
+                bench_scenes[sc].name, bench_solvers[k].name, r[k].n, r[k].nb, 1e3 * r[k].step_s,
+                r[k].n / r[k].step_s, r[k].iterations,
+                r[k].iterations > 0 ? 1e3 * r[k].step_s / r[k].iterations : 0,
+                b.step_s / r[k].step_s, 1e3 * st[SPH_STAGE_NEIGHBORS], 1e3 * st[SPH_STAGE_DENSITY],
+                1e3 * st[SPH_STAGE_PRESSURE], 1e3 * st[SPH_STAGE_FORCES],
+                1e3 * st[SPH_STAGE_INTEGRATE], r[k].pairs, r[k].bytes);
         }
         if (failed[0]) continue;
         printf("  WCSPH stages (ms): neighbours %.3f, density %.3f, pressure %.3f, forces %.3f, "
@@ -194,7 +207,8 @@ static int suite_scaling(const opts* o) {
     static const int scenes[2] = {BENCH_DAMBREAK2D, BENCH_DAMBREAK3D};
     static const int solvers[2] = {BENCH_WCSPH, BENCH_IISPH};
     const int P = max_threads();
-    FILE* f = csv_open(o, "perf_scaling.csv", "scene,solver,threads,n,step_ms,speedup,bitwise_equal");
+    FILE* f =
+        csv_open(o, "perf_scaling.csv", "scene,solver,threads,n,step_ms,speedup,bitwise_equal");
     double xs[4][8], ys[4][8];
     char labels[4][64], path[512];
     int si, so, t, rep, all_equal = 1;
@@ -217,12 +231,17 @@ static int suite_scaling(const opts* o) {
                     if (!run_d(sc, sv, o->n, 5, steps, &m[t - 1].r[m[t - 1].n++])) return 0;
                 }
             printf("%s %s:", bench_scenes[sc].name, bench_solvers[sv].name);
-            snprintf(labels[si * 2 + so], 64, "%s %s", bench_scenes[sc].name, bench_solvers[sv].name);
+            snprintf(labels[si * 2 + so], 64, "%s %s", bench_scenes[sc].name,
+                     bench_solvers[sv].name);
             for (t = 1; t <= P && t <= 8; ++t) {
                 const bench_result r = med_pick(&m[t - 1]);
                 int equal = 1, k;
-                if (t == 1) { t1 = r.step_s; h1 = r.hash; }
-                for (k = 0; k < m[t - 1].n; ++k) equal &= m[t - 1].r[k].hash == h1;
+                if (t == 1) {
+                    t1 = r.step_s;
+                    h1 = r.hash;
+                }
+                for (k = 0; k < m[t - 1].n; ++k)
+                    equal &= m[t - 1].r[k].hash == h1;
                 all_equal &= equal;
                 xs[si * 2 + so][t - 1] = t;
                 ys[si * 2 + so][t - 1] = t1 / r.step_s;
@@ -241,9 +260,11 @@ static int suite_scaling(const opts* o) {
     {
         double ix[8], iy[8];
         int n = P < 8 ? P : 8;
-        for (t = 0; t < n; ++t) ix[t] = iy[t] = t + 1;
+        for (t = 0; t < n; ++t)
+            ix[t] = iy[t] = t + 1;
         svg_series(&ch, ix, iy, (size_t)n, SVG_DASHED, "ideal");
-        for (si = 0; si < 4; ++si) svg_series(&ch, xs[si], ys[si], (size_t)n, SVG_LINE_MARKS, labels[si]);
+        for (si = 0; si < 4; ++si)
+            svg_series(&ch, xs[si], ys[si], (size_t)n, SVG_LINE_MARKS, labels[si]);
     }
     out_path(o, "perf_scaling.svg", path, sizeof path);
     svg_write(&ch, path);
@@ -253,8 +274,9 @@ static int suite_scaling(const opts* o) {
 
 static int suite_search(const opts* o) {
     static const int scenes[2] = {BENCH_DAMBREAK2D, BENCH_DAMBREAK3D};
-    FILE* f = csv_open(o, "perf_search.csv",
-                       "scene,n,code,grid_ns_per_particle,lists_ns_per_particle,pairs_per_particle");
+    FILE* f =
+        csv_open(o, "perf_search.csv",
+                 "scene,n,code,grid_ns_per_particle,lists_ns_per_particle,pairs_per_particle");
     int si, rep;
     if (!f) return 0;
     set_threads(1);
@@ -267,10 +289,15 @@ static int suite_search(const opts* o) {
         memset(&rb, 0, sizeof rb);
         for (rep = 0; rep < o->repeats && rep < 16; ++rep) {
             if (!run_search_d(scenes[si], o->n, reps, &r, &rb)) return 0;
-            g[rep] = r.grid_s; l[rep] = r.lists_s; gb[rep] = rb.grid_s; lb[rep] = rb.lists_s;
+            g[rep] = r.grid_s;
+            l[rep] = r.lists_s;
+            gb[rep] = rb.grid_s;
+            lb[rep] = rb.lists_s;
         }
-        r.grid_s = median(g, rep); r.lists_s = median(l, rep);
-        rb.grid_s = median(gb, rep); rb.lists_s = median(lb, rep);
+        r.grid_s = median(g, rep);
+        r.lists_s = median(l, rep);
+        rb.grid_s = median(gb, rep);
+        rb.lists_s = median(lb, rep);
         printf("%s, %.0f particles: grid build %.1f ns/particle (baseline %.1f, x%.2f), list build "
                "%.1f ns/particle (baseline %.1f, x%.2f), %.1f pairs/particle (baseline %.1f)\n",
                bench_scenes[scenes[si]].name, r.n, 1e9 * r.grid_s / r.n, 1e9 * rb.grid_s / r.n,
@@ -294,8 +321,9 @@ static int suite_float(const opts* o) {
     printf("\n== float against double: WCSPH, 1 thread, median of %d\n", o->repeats);
     for (si = 0; si < 2; ++si) {
         const int sc = scenes[si], dim = bench_scenes[sc].dim;
-        const int steps = o->steps ? o->steps : steps_for(o->n, solver_cost[0] * (dim == 3 ? 4 : 1),
-                                                          o->quick ? 0.25 : 2.0, 5, 200);
+        const int steps = o->steps ? o->steps
+                                   : steps_for(o->n, solver_cost[0] * (dim == 3 ? 4 : 1),
+                                               o->quick ? 0.25 : 2.0, 5, 200);
         double td[16], tf[16], n = 0, md, mf;
         bench_result r;
         for (rep = 0; rep < o->repeats && rep < 16; ++rep) {
@@ -309,7 +337,8 @@ static int suite_float(const opts* o) {
         mf = median(tf, rep);
         printf("%s, %.0f particles: double %.3f ms/step, float %.3f ms/step: float x%.2f\n",
                bench_scenes[sc].name, n, 1e3 * md, 1e3 * mf, md / mf);
-        fprintf(f, "%s,%.0f,%.6f,%.6f,%.3f\n", bench_scenes[sc].name, n, 1e3 * md, 1e3 * mf, md / mf);
+        fprintf(f, "%s,%.0f,%.6f,%.6f,%.3f\n", bench_scenes[sc].name, n, 1e3 * md, 1e3 * mf,
+                md / mf);
     }
     fclose(f);
     return 1;
@@ -321,15 +350,18 @@ static int suite_memory(const opts* o) {
     double b3;
     if (!f) return 0;
     set_threads(1);
-    printf("\n== memory (sph_world_memory / fluid particles: every array, neighbour lists included)\n");
+    printf("\n== memory (sph_world_memory / fluid particles: every array, neighbour lists "
+           "included)\n");
     if (!run_d(BENCH_DAMBREAK2D, BENCH_WCSPH, o->n, 0, 2, &r)) return 0;
     if (!run_baseline_d(BENCH_DAMBREAK2D, o->n, 0, 2, &b)) return 0;
     b3 = bytes_3d_multiphase_d(o->n);
     printf("2D WCSPH single phase, %.0f particles: %.0f bytes/particle (baseline %.0f)\n", r.n,
            r.bytes, b.bytes);
     printf("3D WCSPH two phases, ~%.0f particles: %.0f bytes/particle\n", o->n, b3);
-    fprintf(f, "dambreak2d wcsph,%.0f,%.1f\nbaseline dambreak2d,%.0f,%.1f\n3d two-phase wcsph,%.0f,%.1f\n",
-            r.n, r.bytes, b.n, b.bytes, o->n, b3);
+    fprintf(
+        f,
+        "dambreak2d wcsph,%.0f,%.1f\nbaseline dambreak2d,%.0f,%.1f\n3d two-phase wcsph,%.0f,%.1f\n",
+        r.n, r.bytes, b.n, b.bytes, o->n, b3);
     fclose(f);
     return 1;
 }
@@ -357,8 +389,9 @@ static int suite_growth(const opts* o) {
             if (k != BENCH_WCSPH && k != BENCH_NSOLVER && ns[i] > 3.1e5) continue;
             memset(&m, 0, sizeof m);
             for (rep = 0; rep < o->repeats; ++rep) {
-                const int ok = k == BENCH_NSOLVER ? run_baseline_d(BENCH_DAMBREAK2D, ns[i], 3, steps, &m.r[m.n])
-                                                  : run_d(BENCH_DAMBREAK2D, k, ns[i], 3, steps, &m.r[m.n]);
+                const int ok = k == BENCH_NSOLVER
+                                   ? run_baseline_d(BENCH_DAMBREAK2D, ns[i], 3, steps, &m.r[m.n])
+                                   : run_d(BENCH_DAMBREAK2D, k, ns[i], 3, steps, &m.r[m.n]);
                 if (!ok) return 0;
                 ++m.n;
             }
@@ -366,8 +399,9 @@ static int suite_growth(const opts* o) {
             X[k][cnt[k]] = r.n;
             Y[k][cnt[k]] = r.n / r.step_s;
             cnt[k]++;
-            fprintf(f, "%s,%.0f,%.6f,%.6g,%.2f\n", k == BENCH_NSOLVER ? "baseline" : bench_solvers[k].name,
-                    r.n, 1e3 * r.step_s, r.n / r.step_s, r.iterations);
+            fprintf(f, "%s,%.0f,%.6f,%.6g,%.2f\n",
+                    k == BENCH_NSOLVER ? "baseline" : bench_solvers[k].name, r.n, 1e3 * r.step_s,
+                    r.n / r.step_s, r.iterations);
         }
         { /* least-squares slope of log(time per step) against log N, from 10^4 up */
             double sx = 0, sy = 0, sxx = 0, sxy = 0, m = 0, slope;
@@ -375,15 +409,17 @@ static int suite_growth(const opts* o) {
             for (i = 0; i < cnt[k]; ++i) {
                 printf(" %7.0f:%.3gms", X[k][i], 1e3 * X[k][i] / Y[k][i]);
                 if (X[k][i] < 0.9e4 && !o->quick) continue;
-                sx += log(X[k][i]); sy += log(X[k][i] / Y[k][i]);
-                sxx += log(X[k][i]) * log(X[k][i]); sxy += log(X[k][i]) * log(X[k][i] / Y[k][i]);
+                sx += log(X[k][i]);
+                sy += log(X[k][i] / Y[k][i]);
+                sxx += log(X[k][i]) * log(X[k][i]);
+                sxy += log(X[k][i]) * log(X[k][i] / Y[k][i]);
                 m += 1;
             }
             slope = (m * sxy - sx * sy) / (m * sxx - sx * sx);
             printf("\n             time per step ~ N^%.3f (fit over N >= %s)\n", slope,
                    o->quick ? "10^3" : "10^4");
-            fprintf(f, "%s,fit_exponent,%.4f,,\n", k == BENCH_NSOLVER ? "baseline" : bench_solvers[k].name,
-                    slope);
+            fprintf(f, "%s,fit_exponent,%.4f,,\n",
+                    k == BENCH_NSOLVER ? "baseline" : bench_solvers[k].name, slope);
         }
     }
     fclose(f);
@@ -392,7 +428,8 @@ static int suite_growth(const opts* o) {
     svg_log(&ch, 0);
     svg_log(&ch, 1);
     for (k = 0; k <= BENCH_NSOLVER; ++k)
-        svg_series(&ch, X[k], Y[k], (size_t)cnt[k], k == BENCH_NSOLVER ? SVG_DASHED : SVG_LINE_MARKS,
+        svg_series(&ch, X[k], Y[k], (size_t)cnt[k],
+                   k == BENCH_NSOLVER ? SVG_DASHED : SVG_LINE_MARKS,
                    k == BENCH_NSOLVER ? "baseline WCSPH" : bench_solvers[k].name);
     out_path(o, "perf_growth.svg", path, sizeof path);
     svg_write(&ch, path);
@@ -401,18 +438,21 @@ static int suite_growth(const opts* o) {
 }
 
 static int suite_model(const opts* o) {
-    FILE* f = csv_open(o, "perf_model.csv", "variant,n,step_ms,ratio_to_defaults,bytes_per_particle,"
-                                            "iterations");
+    FILE* f = csv_open(o, "perf_model.csv",
+                       "variant,n,step_ms,ratio_to_defaults,bytes_per_particle,"
+                       "iterations");
     double t0 = 0;
     int m, rep;
     if (!f) return 0;
     set_threads(1);
-    printf("\n== model no more than a scene needs: 2D dam break, %.0f particles, 1 thread, median of %d\n",
+    printf("\n== model no more than a scene needs: 2D dam break, %.0f particles, 1 thread, median "
+           "of %d\n",
            o->n, o->repeats);
     printf("  %-52s %9s %9s %11s\n", "variant", "ms/step", "x default", "bytes/part");
     for (m = 0; m < BENCH_NMODEL; ++m) {
-        const int steps = o->steps ? o->steps : steps_for(o->n, m >= BENCH_M_PCISPH ? 8000 : 500,
-                                                          o->quick ? 0.15 : 1.0, 3, 100);
+        const int steps = o->steps ? o->steps
+                                   : steps_for(o->n, m >= BENCH_M_PCISPH ? 8000 : 500,
+                                               o->quick ? 0.15 : 1.0, 3, 100);
         med_run mr;
         bench_result r;
         memset(&mr, 0, sizeof mr);
@@ -420,7 +460,8 @@ static int suite_model(const opts* o) {
             if (!run_model_d(m, o->n, 5, steps, &mr.r[mr.n++])) return 0;
         r = med_pick(&mr);
         if (m == 0) t0 = r.step_s;
-        printf("  %-52s %9.3f %9.2f %11.0f\n", bench_model_names[m], 1e3 * r.step_s, r.step_s / t0, r.bytes);
+        printf("  %-52s %9.3f %9.2f %11.0f\n", bench_model_names[m], 1e3 * r.step_s, r.step_s / t0,
+               r.bytes);
         fprintf(f, "\"%s\",%.0f,%.6f,%.3f,%.1f,%.2f\n", bench_model_names[m], r.n, 1e3 * r.step_s,
                 r.step_s / t0, r.bytes, r.iterations);
     }
@@ -432,8 +473,8 @@ static int suite_run(const opts* o) {
     med_run m;
     bench_result r;
     int rep, k;
-    static const char* stage_names[6] = {"boundary", "neighbors", "density", "pressure", "forces",
-                                         "integrate"};
+    static const char* stage_names[6] = {"boundary", "neighbors", "density",
+                                         "pressure", "forces",    "integrate"};
     memset(&m, 0, sizeof m);
     set_threads(o->threads);
     for (rep = 0; rep < o->repeats; ++rep)
@@ -443,7 +484,8 @@ static int suite_run(const opts* o) {
            "%.1f iterations, %.1f pairs/particle, %.0f bytes/particle\n  stages (ms):",
            bench_scenes[o->scene].name, bench_solvers[o->solver].name, o->threads, r.n, r.nb,
            1e3 * r.step_s, r.n / r.step_s, r.iterations, r.pairs, r.bytes);
-    for (k = 0; k < 6; ++k) printf(" %s %.3f", stage_names[k], 1e3 * r.stage_s[k]);
+    for (k = 0; k < 6; ++k)
+        printf(" %s %.3f", stage_names[k], 1e3 * r.stage_s[k]);
     printf("\n");
     return 1;
 }
@@ -453,11 +495,13 @@ static int suite_iisph_sweep(const opts* o) {
     static const double fs[] = {0.005, 0.0075, 0.01, 0.015, 0.02, 0.03, 0.05, 0.08};
     const int res = o->quick ? 20 : 40;
     const double dx = 0.5 / res, unit = sqrt(dx / 9.81);
-    FILE* f = csv_open(o, "iisph_sweep.csv", "dt,dt_units,steps,iterations,pressure_s,neighbors_s,overall_s");
+    FILE* f = csv_open(o, "iisph_sweep.csv",
+                       "dt,dt_units,steps,iterations,pressure_s,neighbors_s,overall_s");
     size_t k;
     if (!f) return 0;
     set_threads(o->threads);
-    printf("\n== IISPH hydrostatic tank, %d particles deep, 1 s simulated, %d thread(s)\n", res, o->threads);
+    printf("\n== IISPH hydrostatic tank, %d particles deep, 1 s simulated, %d thread(s)\n", res,
+           o->threads);
     printf("%9s %15s %7s %10s %12s %13s %11s\n", "dt [s]", "dt/sqrt(dx/g)", "steps", "iterations",
            "pressure [s]", "neighbors [s]", "overall [s]");
     for (k = 0; k < sizeof(fs) / sizeof(fs[0]); ++k) {
@@ -467,9 +511,15 @@ static int suite_iisph_sweep(const opts* o) {
         double its = 0;
         int steps = 0;
         def.solver = SPH_SOLVER_IISPH;
-        if (scene_hydrostatic(&w, def, 1.0, 0.5, res) != SPH_OK) { fprintf(stderr, "%s\n", scene_error); return 0; }
+        if (scene_hydrostatic(&w, def, 1.0, 0.5, res) != SPH_OK) {
+            fprintf(stderr, "%s\n", scene_error);
+            return 0;
+        }
         while (w.time < 1.0 - 1e-9) {
-            if (sph_step(&w, (sph_real)dt) != SPH_OK) { fprintf(stderr, "%s\n", w.error); return 0; }
+            if (sph_step(&w, (sph_real)dt) != SPH_OK) {
+                fprintf(stderr, "%s\n", w.error);
+                return 0;
+            }
             its += w.stats.iterations;
             ++steps;
         }
@@ -493,12 +543,12 @@ static int find_name(const char* s, const char* const* names, int n) {
 }
 
 int main(int argc, char** argv) {
-    static const char* const suites[] = {"throughput", "scaling", "search", "float", "memory",
-                                         "growth", "model", "run", "iisph-sweep"};
+    static const char* const suites[] = {"throughput", "scaling", "search", "float",      "memory",
+                                         "growth",     "model",   "run",    "iisph-sweep"};
     enum { NSUITE = 9, NDEFAULT = 7 };
     int (*const fns[NSUITE])(const opts*) = {suite_throughput, suite_scaling, suite_search,
-                                             suite_float, suite_memory, suite_growth,
-                                             suite_model, suite_run, suite_iisph_sweep};
+                                             suite_float,      suite_memory,  suite_growth,
+                                             suite_model,      suite_run,     suite_iisph_sweep};
     const char* scene_names[BENCH_NSCENE];
     const char* solver_names[BENCH_NSOLVER];
     int want[NSUITE] = {0}, any = 0, k, ok = 1;
@@ -508,22 +558,36 @@ int main(int argc, char** argv) {
     o.repeats = 3;
     o.threads = 1;
     o.out = "bench/results";
-    for (k = 0; k < BENCH_NSCENE; ++k) scene_names[k] = bench_scenes[k].name;
-    for (k = 0; k < BENCH_NSOLVER; ++k) solver_names[k] = bench_solvers[k].name;
+    for (k = 0; k < BENCH_NSCENE; ++k)
+        scene_names[k] = bench_scenes[k].name;
+    for (k = 0; k < BENCH_NSOLVER; ++k)
+        solver_names[k] = bench_solvers[k].name;
     for (k = 1; k < argc; ++k) {
         const char* a = argv[k];
         const char* v = k + 1 < argc ? argv[k + 1] : NULL;
         int s;
-        if (strcmp(a, "--quick") == 0) { o.quick = 1; continue; }
-        if (a[0] == '-' && a[1] == '-' && !v) { fprintf(stderr, "bench: %s needs a value\n", a); return 2; }
-        if (strcmp(a, "--out") == 0) o.out = v;
-        else if (strcmp(a, "--n") == 0) o.n = atof(v);
-        else if (strcmp(a, "--repeats") == 0) o.repeats = atoi(v);
-        else if (strcmp(a, "--steps") == 0) o.steps = atoi(v);
-        else if (strcmp(a, "--threads") == 0) o.threads = atoi(v);
+        if (strcmp(a, "--quick") == 0) {
+            o.quick = 1;
+            continue;
+        }
+        if (a[0] == '-' && a[1] == '-' && !v) {
+            fprintf(stderr, "bench: %s needs a value\n", a);
+            return 2;
+        }
+        if (strcmp(a, "--out") == 0)
+            o.out = v;
+        else if (strcmp(a, "--n") == 0)
+            o.n = atof(v);
+        else if (strcmp(a, "--repeats") == 0)
+            o.repeats = atoi(v);
+        else if (strcmp(a, "--steps") == 0)
+            o.steps = atoi(v);
+        else if (strcmp(a, "--threads") == 0)
+            o.threads = atoi(v);
         else if (strcmp(a, "--scene") == 0) {
             if ((o.scene = find_name(v, scene_names, BENCH_NSCENE)) < 0) {
-                fprintf(stderr, "bench: unknown scene %s (dambreak2d, dambreak3d, hydrostatic2d)\n", v);
+                fprintf(stderr, "bench: unknown scene %s (dambreak2d, dambreak3d, hydrostatic2d)\n",
+                        v);
                 return 2;
             }
         } else if (strcmp(a, "--solver") == 0) {
@@ -535,16 +599,25 @@ int main(int argc, char** argv) {
             want[s] = any = 1;
             continue;
         } else {
-            fprintf(stderr, "bench: unknown argument %s (see the comment at the top of bench/bench.c)\n", a);
+            fprintf(stderr,
+                    "bench: unknown argument %s (see the comment at the top of bench/bench.c)\n",
+                    a);
             return 2;
         }
         ++k;
     }
-    if (o.repeats < 1 || o.repeats > 16 || o.threads < 1) { fprintf(stderr, "bench: bad --repeats/--threads\n"); return 2; }
+    if (o.repeats < 1 || o.repeats > 16 || o.threads < 1) {
+        fprintf(stderr, "bench: bad --repeats/--threads\n");
+        return 2;
+    }
     if (o.n <= 0) o.n = o.quick ? 2e4 : 1e5;
-    if (!any) for (k = 0; k < NDEFAULT; ++k) want[k] = 1;
-    printf("sph.h %d.%d.%d bench: %s mode, %d processor(s), target %.0f fluid particles, median of %d%s\n",
-           SPH_VERSION_MAJOR, SPH_VERSION_MINOR, SPH_VERSION_PATCH, o.quick ? "quick" : "full", max_threads(), o.n, o.repeats,
+    if (!any)
+        for (k = 0; k < NDEFAULT; ++k)
+            want[k] = 1;
+    printf("sph.h %d.%d.%d bench: %s mode, %d processor(s), target %.0f fluid particles, median of "
+           "%d%s\n",
+           SPH_VERSION_MAJOR, SPH_VERSION_MINOR, SPH_VERSION_PATCH, o.quick ? "quick" : "full",
+           max_threads(), o.n, o.repeats,
 #ifdef _OPENMP
            ", OpenMP"
 #else

@@ -14,10 +14,17 @@ BENCH_FN int BX(build)(sph_world* w, int scene, int solver, double target) {
     sph_world_def def = sph_world_def_default(dim);
     int res;
     switch (solver) {
-    case BENCH_PCISPH: sph_world_def_pcisph(&def, 0); break;
-    case BENCH_PCISPH_ENH: sph_world_def_pcisph(&def, 1); break;
-    case BENCH_IISPH: def.solver = SPH_SOLVER_IISPH; break;
-    default: break;
+    case BENCH_PCISPH:
+        sph_world_def_pcisph(&def, 0);
+        break;
+    case BENCH_PCISPH_ENH:
+        sph_world_def_pcisph(&def, 1);
+        break;
+    case BENCH_IISPH:
+        def.solver = SPH_SOLVER_IISPH;
+        break;
+    default:
+        break;
     }
     switch (scene) {
     case BENCH_DAMBREAK2D: /* n = a/dx * 2a/dx */
@@ -29,14 +36,16 @@ BENCH_FN int BX(build)(sph_world* w, int scene, int solver, double target) {
     case BENCH_HYDROSTATIC2D: /* 1 m x 0.5 m: n = 2 res^2 */
         res = (int)floor(sqrt(target / 2) + 0.5);
         return scene_hydrostatic(w, def, 1.0, 0.5, res < 2 ? 2 : res) == SPH_OK;
-    default: return 0;
+    default:
+        return 0;
     }
 }
 
 BENCH_FN uint64_t BX(fnv)(uint64_t h, const void* data, size_t n) {
     const unsigned char* p = (const unsigned char*)data;
     size_t i;
-    for (i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
+    for (i = 0; i < n; ++i)
+        h = (h ^ p[i]) * 1099511628211ull;
     return h;
 }
 
@@ -77,7 +86,8 @@ BENCH_FN int BX(run)(int scene, int solver, double target, int warm, int steps, 
     for (s = 0; s < warm; ++s)
         if (sph_step(&w, (sph_real)dt) != SPH_OK) goto fail;
     w.step_time_total = 0;
-    for (k = 0; k < SPH_STAGE_COUNT; ++k) w.stage_time_total[k] = 0;
+    for (k = 0; k < SPH_STAGE_COUNT; ++k)
+        w.stage_time_total[k] = 0;
     for (s = 0; s < steps; ++s) {
         if (sph_step(&w, (sph_real)dt) != SPH_OK) goto fail;
         its += w.stats.iterations;
@@ -86,7 +96,8 @@ BENCH_FN int BX(run)(int scene, int solver, double target, int warm, int steps, 
     r->nb = (double)w.nb;
     r->dt = dt;
     r->step_s = w.step_time_total / steps;
-    for (k = 0; k < SPH_STAGE_COUNT && k < 8; ++k) r->stage_s[k] = w.stage_time_total[k] / steps;
+    for (k = 0; k < SPH_STAGE_COUNT && k < 8; ++k)
+        r->stage_s[k] = w.stage_time_total[k] / steps;
     r->iterations = solver == BENCH_WCSPH ? 0 : its / steps; /* WCSPH reports 1 */
     r->pairs = (double)w.stats.pairs / (double)w.n;
     r->bytes = (double)sph_world_memory(&w) / (double)w.n;
@@ -110,7 +121,10 @@ BENCH_FN int BX(run_baseline)(int scene, double target, int warm, int steps, ben
     memset(r, 0, sizeof(*r));
     if (!BX(build)(&w, scene, BENCH_WCSPH, target)) return 0;
     dt = (double)sph_stable_dt(&w, SPH_SOLVER_WCSPH);
-    if (!base_init(&b, &w) || b.c0 <= 0) { sph_world_free(&w); return 0; }
+    if (!base_init(&b, &w) || b.c0 <= 0) {
+        sph_world_free(&w);
+        return 0;
+    }
     for (s = 0; s < warm; ++s)
         if (!base_step(&b, (sph_real)dt)) goto fail;
     b.t_grid = b.t_lists = b.t_density = b.t_forces = b.t_other = 0;
@@ -134,7 +148,8 @@ BENCH_FN int BX(run_baseline)(int scene, double target, int warm, int steps, ben
     {
         size_t* at = (size_t*)malloc((b.n + 1) * sizeof(size_t));
         if (!at) goto fail;
-        for (i = 0; i < b.n; ++i) at[b.id[i]] = i;
+        for (i = 0; i < b.n; ++i)
+            at[b.id[i]] = i;
         for (i = 0; i < w.n; ++i) {
             const size_t j = at[w.id[i]];
             int k;
@@ -171,7 +186,10 @@ BENCH_FN int BX(run_search)(int scene, double target, int reps, bench_result* r,
     memset(rb, 0, sizeof(*rb));
     memset(&nl, 0, sizeof(nl));
     if (!BX(build)(&w, scene, BENCH_WCSPH, target)) return 0;
-    if (!base_init(&b, &w)) { sph_world_free(&w); return 0; }
+    if (!base_init(&b, &w)) {
+        sph_world_free(&w);
+        return 0;
+    }
     if (sph_step(&w, sph_stable_dt(&w, SPH_SOLVER_WCSPH)) != SPH_OK ||
         sph_grid_init(&g, w.dim, w.kernel.radius, NULL, NULL, NULL) != SPH_OK) {
         base_free(&b);
@@ -193,12 +211,15 @@ BENCH_FN int BX(run_search)(int scene, double target, int reps, bench_result* r,
         if (s) rb->lists_s += bench_now() - t0;
     }
     r->n = rb->n = (double)w.n;
-    r->grid_s /= reps; r->lists_s /= reps;
-    rb->grid_s /= reps; rb->lists_s /= reps;
+    r->grid_s /= reps;
+    r->lists_s /= reps;
+    rb->grid_s /= reps;
+    rb->lists_s /= reps;
     r->pairs = (double)nl.total / (double)w.n;
     {
         size_t i, tot = 0;
-        for (i = 0; i < b.n; ++i) tot += b.ffn[i];
+        for (i = 0; i < b.n; ++i)
+            tot += b.ffn[i];
         rb->pairs = (double)tot / (double)b.n;
     }
     ok = ok && !b.overflow;
@@ -211,14 +232,29 @@ BENCH_FN int BX(run_search)(int scene, double target, int reps, bench_result* r,
 
 /* "Model no more than a scene needs": the 2D dam break with one optional piece of physics on. */
 enum {
-    BENCH_M_BASE, BENCH_M_NODELTA, BENCH_M_VERLET, BENCH_M_SUMMATION, BENCH_M_VISCOUS,
-    BENCH_M_AKINCI, BENCH_M_TWOPHASE, BENCH_M_ENERGY, BENCH_M_PCISPH, BENCH_M_IISPH, BENCH_NMODEL
+    BENCH_M_BASE,
+    BENCH_M_NODELTA,
+    BENCH_M_VERLET,
+    BENCH_M_SUMMATION,
+    BENCH_M_VISCOUS,
+    BENCH_M_AKINCI,
+    BENCH_M_TWOPHASE,
+    BENCH_M_ENERGY,
+    BENCH_M_PCISPH,
+    BENCH_M_IISPH,
+    BENCH_NMODEL
 };
 static const char* const bench_model_names[BENCH_NMODEL] = {
-    "defaults (continuity, delta-SPH, extrapolated walls)", "delta-SPH off",
-    "Stormer-Verlet", "summation density", "laminar viscosity + no-slip walls",
-    "Akinci wall volumes", "two phases (upper half 800 kg/m^3)",
-    "energy equation (compressible step)", "PCISPH enhanced (for scale)", "IISPH (for scale)"};
+    "defaults (continuity, delta-SPH, extrapolated walls)",
+    "delta-SPH off",
+    "Stormer-Verlet",
+    "summation density",
+    "laminar viscosity + no-slip walls",
+    "Akinci wall volumes",
+    "two phases (upper half 800 kg/m^3)",
+    "energy equation (compressible step)",
+    "PCISPH enhanced (for scale)",
+    "IISPH (for scale)"};
 
 BENCH_FN int BX(build_model)(sph_world* w, int model, double target) {
     sph_world_def def = sph_world_def_default(2);
@@ -233,19 +269,40 @@ BENCH_FN int BX(build_model)(sph_world* w, int model, double target) {
     oil.rest_density = 800;
     def.spacing = (sph_real)(a / res);
     switch (model) {
-    case BENCH_M_NODELTA: def.delta = 0; break;
-    case BENCH_M_VERLET: def.integrator = SPH_INTEGRATOR_VERLET; break;
-    case BENCH_M_SUMMATION: def.density = SPH_DENSITY_SUMMATION; break;
-    case BENCH_M_VISCOUS: water.viscosity = (sph_real)1e-6; def.wall = SPH_WALL_NO_SLIP; break;
-    case BENCH_M_AKINCI: def.boundary_volume = SPH_BVOL_AKINCI; break;
-    case BENCH_M_ENERGY: def.solver = SPH_SOLVER_COMPRESSIBLE; break;
-    case BENCH_M_PCISPH: sph_world_def_pcisph(&def, 1); break;
-    case BENCH_M_IISPH: def.solver = SPH_SOLVER_IISPH; break;
-    default: break;
+    case BENCH_M_NODELTA:
+        def.delta = 0;
+        break;
+    case BENCH_M_VERLET:
+        def.integrator = SPH_INTEGRATOR_VERLET;
+        break;
+    case BENCH_M_SUMMATION:
+        def.density = SPH_DENSITY_SUMMATION;
+        break;
+    case BENCH_M_VISCOUS:
+        water.viscosity = (sph_real)1e-6;
+        def.wall = SPH_WALL_NO_SLIP;
+        break;
+    case BENCH_M_AKINCI:
+        def.boundary_volume = SPH_BVOL_AKINCI;
+        break;
+    case BENCH_M_ENERGY:
+        def.solver = SPH_SOLVER_COMPRESSIBLE;
+        break;
+    case BENCH_M_PCISPH:
+        sph_world_def_pcisph(&def, 1);
+        break;
+    case BENCH_M_IISPH:
+        def.solver = SPH_SOLVER_IISPH;
+        break;
+    default:
+        break;
     }
-    hi[0] = (sph_real)a; hi[1] = (sph_real)(2 * a);
-    mid[0] = (sph_real)a; mid[1] = (sph_real)a;
-    thi[0] = (sph_real)(5 * a); thi[1] = (sph_real)(3 * a);
+    hi[0] = (sph_real)a;
+    hi[1] = (sph_real)(2 * a);
+    mid[0] = (sph_real)a;
+    mid[1] = (sph_real)a;
+    thi[0] = (sph_real)(5 * a);
+    thi[1] = (sph_real)(3 * a);
     if (sph_world_init(w, &def) != SPH_OK) return 0;
     p0 = sph_world_add_phase(w, &water);
     p1 = model == BENCH_M_TWOPHASE ? sph_world_add_phase(w, &oil) : p0;
@@ -253,7 +310,8 @@ BENCH_FN int BX(build_model)(sph_world* w, int model, double target) {
     if (model == BENCH_M_TWOPHASE) {
         sph_real lo1[3] = {0, 0, 0};
         lo1[1] = (sph_real)a;
-        if (sph_fill_box(w, p0, lo, mid) != SPH_OK || sph_fill_box(w, p1, lo1, hi) != SPH_OK) goto fail;
+        if (sph_fill_box(w, p0, lo, mid) != SPH_OK || sph_fill_box(w, p1, lo1, hi) != SPH_OK)
+            goto fail;
     } else if (sph_fill_box(w, p0, lo, hi) != SPH_OK) {
         goto fail;
     }
@@ -270,9 +328,13 @@ BENCH_FN int BX(run_model)(int model, double target, int warm, int steps, bench_
     double dt;
     int s;
     memset(r, 0, sizeof(*r));
-    if (!BX(build_model)(&w, model, target)) { fprintf(stderr, "bench: %s\n", scene_error); return 0; }
-    dt = BX(bench_dt)(&w, model == BENCH_M_PCISPH ? BENCH_PCISPH_ENH
-                          : model == BENCH_M_IISPH ? BENCH_IISPH : BENCH_WCSPH);
+    if (!BX(build_model)(&w, model, target)) {
+        fprintf(stderr, "bench: %s\n", scene_error);
+        return 0;
+    }
+    dt = BX(bench_dt)(&w, model == BENCH_M_PCISPH  ? BENCH_PCISPH_ENH
+                          : model == BENCH_M_IISPH ? BENCH_IISPH
+                                                   : BENCH_WCSPH);
     for (s = 0; s < warm; ++s)
         if (sph_step(&w, (sph_real)dt) != SPH_OK) goto fail;
     w.step_time_total = 0;
@@ -309,9 +371,14 @@ BENCH_FN double BX(bytes_3d_multiphase)(double target) {
     oil = water;
     oil.rest_density = 800;
     def.spacing = (sph_real)(a / res);
-    for (k = 0; k < 3; ++k) { hi[k] = mid[k] = (sph_real)a; thi[k] = (sph_real)a; }
-    hi[1] = (sph_real)(2 * a); lo1[1] = (sph_real)a;
-    thi[0] = (sph_real)(5 * a); thi[1] = (sph_real)(3 * a);
+    for (k = 0; k < 3; ++k) {
+        hi[k] = mid[k] = (sph_real)a;
+        thi[k] = (sph_real)a;
+    }
+    hi[1] = (sph_real)(2 * a);
+    lo1[1] = (sph_real)a;
+    thi[0] = (sph_real)(5 * a);
+    thi[1] = (sph_real)(3 * a);
     if (sph_world_init(&w, &def) != SPH_OK) return 0;
     p0 = sph_world_add_phase(&w, &water);
     p1 = sph_world_add_phase(&w, &oil);

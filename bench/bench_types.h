@@ -40,14 +40,14 @@ static const bench_solver bench_solvers[BENCH_NSOLVER] = {
 
 typedef struct bench_result {
     double n, nb, dt;
-    double step_s;       /* wall-clock seconds per step                              */
-    double stage_s[8];   /* per sph_stage                                            */
-    double iterations;   /* mean solver iterations per step (0 for WCSPH)            */
-    double pairs;        /* fluid neighbour pairs per fluid particle                 */
-    double bytes;        /* sph_world_memory / fluid particles (or the baseline's)   */
+    double step_s;          /* wall-clock seconds per step                              */
+    double stage_s[8];      /* per sph_stage                                            */
+    double iterations;      /* mean solver iterations per step (0 for WCSPH)            */
+    double pairs;           /* fluid neighbour pairs per fluid particle                 */
+    double bytes;           /* sph_world_memory / fluid particles (or the baseline's)   */
     double grid_s, lists_s; /* neighbour search parts (search suite, baseline)       */
-    double agree;        /* baseline: max position difference to sph.h [spacings]   */
-    uint64_t hash;       /* state after the timed steps                              */
+    double agree;           /* baseline: max position difference to sph.h [spacings]   */
+    uint64_t hash;          /* state after the timed steps                              */
 } bench_result;
 
 static double bench_now(void) {
