@@ -1766,25 +1766,20 @@ SPH__INLINE size_t sph__neighbors_chunk_dense(sph_neighbors* nl, const sph_grid*
                     if (pos <= end && end - pos >= qe - q) {
                         uint32_t* out = nl->idx + pos;
                         size_t m = 0, qs = qe; /* the query point itself, when it lies here */
+                        int seg;
                         if (exclude_self && i >= q && i < qe) qs = i;
-                        for (; q < qs; ++q) {
-                            const sph_real* xj = x + q * (size_t)D;
-                            sph_real r2 = 0, dd;
-                            dd = p[0] - xj[0]; r2 += dd * dd;
-                            if (D > 1) { dd = p[1] - xj[1]; r2 += dd * dd; }
-                            if (D > 2) { dd = p[2] - xj[2]; r2 += dd * dd; }
-                            out[m] = (uint32_t)q;
-                            m += (size_t)(r2 < r2max);
-                        }
-                        if (qs < qe) ++q; /* skip the query point, then the rest of the row */
-                        for (; q < qe; ++q) {
-                            const sph_real* xj = x + q * (size_t)D;
-                            sph_real r2 = 0, dd;
-                            dd = p[0] - xj[0]; r2 += dd * dd;
-                            if (D > 1) { dd = p[1] - xj[1]; r2 += dd * dd; }
-                            if (D > 2) { dd = p[2] - xj[2]; r2 += dd * dd; }
-                            out[m] = (uint32_t)q;
-                            m += (size_t)(r2 < r2max);
+                        for (seg = 0; seg < 2; ++seg) { /* the row before the query point, after */
+                            const size_t qend = seg ? qe : qs;
+                            for (; q < qend; ++q) {
+                                const sph_real* xj = x + q * (size_t)D;
+                                sph_real r2 = 0, dd;
+                                dd = p[0] - xj[0]; r2 += dd * dd;
+                                if (D > 1) { dd = p[1] - xj[1]; r2 += dd * dd; }
+                                if (D > 2) { dd = p[2] - xj[2]; r2 += dd * dd; }
+                                out[m] = (uint32_t)q;
+                                m += (size_t)(r2 < r2max);
+                            }
+                            if (!seg && qs < qe) ++q; /* skip the query point */
                         }
                         pos += m;
                     } else {

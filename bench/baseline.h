@@ -14,7 +14,7 @@
    It takes its initial state, kernel and phase constants from an sph_world, so both codes start
    from the same particles; bench checks that they then agree (the same step to round-off),
    which is what makes the speed ratio a fair one.
-   Include after sph.h. Only Wendland C2 and one liquid phase with gamma = 7 are supported. */
+   Include after sph.h and bench_types.h (bench_now). Only Wendland C2 and one liquid phase with gamma = 7 are supported. */
 #ifndef SPH_BENCH_BASELINE_H
 #define SPH_BENCH_BASELINE_H
 
@@ -48,13 +48,6 @@ typedef struct base_world {
     int overflow;
 } base_world;
 
-static double base__now(void) {
-#ifdef _OPENMP
-    return omp_get_wtime();
-#else
-    return (double)clock() / CLOCKS_PER_SEC;
-#endif
-}
 
 static void base__grid_free(base_grid* g) {
     free(g->start);
@@ -273,12 +266,12 @@ static int base_step(base_world* b, sph_real dt) {
     const int D = b->dim;
     const size_t n = b->n, nb = b->nb;
     const sph_real dcoef = b->delta * b->h * b->c0 * 2 * b->rho0;
-    double t0 = base__now(), t1;
+    double t0 = bench_now(), t1;
     long i;
     /* grids and lists, from scratch */
     if (!base__grid_build(&b->gf, D, b->x, n, b->R)) return 0;
     if (nb && !base__grid_build(&b->gb, D, b->bx, nb, b->R)) return 0;
-    t1 = base__now();
+    t1 = bench_now();
     b->t_grid += t1 - t0;
     t0 = t1;
     base__lists(b, &b->gf, b->x, b->x, n, 1, b->ff, b->ffn);
@@ -286,7 +279,7 @@ static int base_step(base_world* b, sph_real dt) {
         base__lists(b, &b->gb, b->bx, b->x, n, 0, b->fb, b->fbn);
         base__lists(b, &b->gf, b->x, b->bx, nb, 0, b->bf, b->bfn);
     }
-    t1 = base__now();
+    t1 = bench_now();
     b->t_lists += t1 - t0;
     t0 = t1;
     if (b->overflow) return 0;
@@ -322,7 +315,7 @@ static int base_step(base_world* b, sph_real dt) {
         b->bp[i] = sw > 0 ? (swp + sgx) / sw : 0;
         b->bkap[i] = sw > 0 ? base__kap(b, b->bp[i]) : 1;
     }
-    t1 = base__now();
+    t1 = bench_now();
     b->t_other += t1 - t0;
     t0 = t1;
     /* forces: pressure (symmetric form) and artificial viscosity; walls without viscosity */
@@ -366,7 +359,7 @@ static int base_step(base_world* b, sph_real dt) {
         for (k = 0; k < D; ++k)
             b->a[(size_t)i * (size_t)D + (size_t)k] += ai[k];
     }
-    t1 = base__now();
+    t1 = bench_now();
     b->t_forces += t1 - t0;
     t0 = t1;
 #pragma omp parallel for schedule(static)
@@ -409,7 +402,7 @@ static int base_step(base_world* b, sph_real dt) {
         }
         b->drho[i] = R;
     }
-    t1 = base__now();
+    t1 = bench_now();
     b->t_density += t1 - t0;
     t0 = t1;
 #pragma omp parallel for schedule(static)
@@ -419,7 +412,7 @@ static int base_step(base_world* b, sph_real dt) {
         for (k = 0; k < D; ++k)
             b->x[(size_t)i * (size_t)D + (size_t)k] += dt * b->v[(size_t)i * (size_t)D + (size_t)k];
     }
-    t1 = base__now();
+    t1 = bench_now();
     b->t_other += t1 - t0;
     return 1;
 }

@@ -86,6 +86,14 @@ typedef struct result {
     sph_status status;
 } result;
 
+/* The end of every run: the failure's message, mean step, the world freed, CPU seconds since c0. */
+static void run_end(result* r, sph_world* w, clock_t c0) {
+    if (r->status != SPH_OK) fprintf(stderr, "  t = %.4f s: %s\n", w->time, w->error);
+    r->dt_mean = r->steps ? w->time / (double)r->steps : 0;
+    sph_world_free(w);
+    r->cpu = (double)(clock() - c0) / CLOCKS_PER_SEC;
+}
+
 static const char* status_text(const result* r) {
     if (r->ok) return "ok";
     if (r->status == SPH_ERR_UNSTABLE) return "unstable";
@@ -146,10 +154,7 @@ static result run_dam(int solver, int res, double factor) {
         r.err = sqrt(sq / m);
         r.ok = isfinite(r.err);
     }
-    if (r.status != SPH_OK) fprintf(stderr, "  t = %.4f s: %s\n", w.time, w.error);
-    r.dt_mean = r.steps ? w.time / (double)r.steps : 0;
-    sph_world_free(&w);
-    r.cpu = (double)(clock() - c0) / CLOCKS_PER_SEC;
+    run_end(&r, &w, c0);
     return r;
 }
 
@@ -201,12 +206,9 @@ static result run_tank(sph_world_def def, int res, double factor, double ratio) 
         r.err = used ? sum / (double)used : NAN;
         r.ok = isfinite(r.err);
     }
-    if (r.status != SPH_OK) fprintf(stderr, "  t = %.4f s: %s\n", w.time, w.error);
-    r.dt_mean = r.steps ? w.time / (double)r.steps : 0;
     free(psum);
     free(cnt);
-    sph_world_free(&w);
-    r.cpu = (double)(clock() - c0) / CLOCKS_PER_SEC;
+    run_end(&r, &w, c0);
     return r;
 }
 
@@ -271,10 +273,7 @@ static result run_cavity(int solver, int res, double factor, FILE* log) {
         r.err = sqrt(sq / m);
         r.ok = isfinite(r.err);
     }
-    if (r.status != SPH_OK) fprintf(stderr, "  t = %.4f s: %s\n", w.time, w.error);
-    r.dt_mean = r.steps ? w.time / (double)r.steps : 0;
-    sph_world_free(&w);
-    r.cpu = (double)(clock() - c0) / CLOCKS_PER_SEC;
+    run_end(&r, &w, c0);
     return r;
 }
 
