@@ -1762,8 +1762,8 @@ SPH__INLINE size_t sph__neighbors_chunk_dense(sph_neighbors* nl, const sph_grid*
                        point itself is skipped by splitting the row around it instead of a test
                        per candidate. With the split, the 2D neighbour stage went from 18.5 to
                        14.5 ms at 100k particles (the branch-free write alone: no measurable
-                       change). */
-                    if (pos <= end && end - pos >= qe - q) {
+                       change). An empty row does nothing (idx may still be NULL). */
+                    if (q < qe && pos <= end && end - pos >= qe - q) {
                         uint32_t* out = nl->idx + pos;
                         size_t m = 0, qs = qe; /* the query point itself, when it lies here */
                         int seg;
