@@ -316,11 +316,16 @@ typedef enum sph_status {
     SPH_ERR_NOMEM,         /* an allocation failed; the world is still valid and usable         */
     SPH_ERR_CAPACITY,      /* a count exceeds what the library can index (more than 2^32 - 2
                               fluid or boundary particles, more than SPH_MAX_PHASES phases)   */
-    SPH_ERR_UNSTABLE,      /* a step produced a non-finite value or a runaway density/speed, or
-                              sph_advance's stable time step collapsed                        */
-    SPH_ERR_NOT_CONVERGED, /* reserved, not returned: a solver that reaches def.max_iterations
-                              finishes the step with its last pressure (see w.stats)          */
+    SPH_ERR_UNSTABLE,      /* a step produced a non-finite value, a runaway density or speed, a
+                              particle that moved more than def.max_displacement in one step
+                              or entered a wall; or sph_advance could not find a step that
+                              succeeds                                                        */
+    SPH_ERR_NOT_CONVERGED, /* an iterative pressure solve (PCISPH, IISPH) reached
+                              def.max_iterations with its error above def.tolerance: the step
+                              was taken with the last pressure (sph_advance retries it)       */
     SPH_ERR_IO,            /* a file could not be opened, written or read (errno says why)      */
+    SPH_ERR_BUDGET,        /* sph_advance needed more than def.max_substeps sub-steps; the world
+                              is as before the call                                           */
     SPH_STATUS_COUNT
 } sph_status;
 
@@ -711,9 +716,23 @@ typedef struct sph_world_def {
                                   be at least two kernel support radii long; default 0          */
     sph_real max_compression;  /* blow-up if rho/rho0 - 1 exceeds it [-]; default 0.2; 0 = no
                                   check; >= 0; not applied to gas phases                         */
-    sph_real max_speed;        /* blow-up if |v| exceeds it [m/s]; 0 (default) = the largest c0,
-                                  10 c0 in the compressible step (no check while no c0 is set);
-                                  >= 0                                                           */
+    sph_real max_speed;        /* blow-up if |v| exceeds it [m/s]; 0 (default) = the largest c0
+                                  (WCSPH), 10 c0 (compressible step); for PCISPH and IISPH
+                                  3 sqrt(2 |g| L) + 2 |v_wall|max + 3 |v|max at the step's start,
+                                  L the height of fluid and walls along gravity (a runaway, not
+                                  a fast flow); no check while neither is set; >= 0              */
+    sph_real max_displacement; /* blow-up if a fluid particle moves more than this many spacings
+                                  dx in one step [-] (a large step through a thin wall, or a
+                                  runaway); default 1; 0 = no check; >= 0                        */
+    int check_walls;           /* nonzero (default): a fluid particle that ends a step inside the
+                                  wall layers (its wall volume fraction sum_b V_b W_ib / S beyond
+                                  that of a particle on the first layer of a flat wall) fails
+                                  the step with SPH_ERR_UNSTABLE naming it; lattice walls of
+                                  given volumes only (not SPH_BVOL_AKINCI, whose single layers
+                                  weigh as a full wall). 0 = off                                */
+    int max_substeps;          /* sph_advance: at most this many sub-steps (retries included) per
+                                  call, else SPH_ERR_BUDGET with the world as before the call;
+                                  default 100000; [1, 2^30]                                      */
     sph_force_fn force;        /* optional external accelerations (sph_force_fn); default NULL  */
     void* force_user;          /* passed to force as user                                        */
     sph_boundary_fn boundary_motion; /* optional moving boundary particles (default NULL)        */
@@ -765,6 +784,13 @@ typedef struct sph_stats {
                                  direction (kept, still simulated)                               */
     double stage_time[SPH_STAGE_COUNT]; /* wall-clock seconds per stage                            */
     double step_time;         /* wall-clock seconds of the whole step                              */
+    /* set by sph_advance for its last call (unchanged by sph_step_*): */
+    int substeps;             /* sub-steps taken, retries included                                 */
+    int retries;              /* sub-steps rolled back and retried with a smaller step             */
+    double dt_min;            /* smallest sub-step that succeeded [s] (0 if none)                  */
+    double dt_factor;         /* the step control's factor on sph_stable_dt after the call [-]: 1
+                                 unless failed steps made it smaller; it grows back by 1.1 per
+                                 successful sub-step                                             */
 } sph_stats;
 
 /* Private state (do not touch). */
@@ -809,6 +835,12 @@ typedef struct sph__private {
     int b_dirty;                    /* boundary particles changed since the last boundary grid     */
     int have_mass;                  /* w->mass is set                                               */
     sph_real lattice_sum;           /* dx^dim sum_j W(x_j) over a square lattice of spacing dx     */
+    sph_real wall_fraction_max;     /* check_walls: wall volume fraction of a particle on the
+                                       first layer of a flat lattice wall                          */
+    uint8_t* snap[2];               /* sph_advance: the state at the call's start [0] and at the
+                                       current sub-step's start [1] (rollback)                      */
+    size_t snap_cap[2];             /* bytes                                                        */
+    double dt_factor;               /* sph_advance: factor on sph_stable_dt (failed steps shrink it) */
 } sph__private;
 
 /* The world: a caller-owned plain struct. Read the arrays directly; positions and velocities may
@@ -1194,6 +1226,7 @@ SPHDEF const char* sph_status_string(sph_status status) {
     case SPH_ERR_UNSTABLE: return "simulation unstable";
     case SPH_ERR_NOT_CONVERGED: return "solver did not converge";
     case SPH_ERR_IO: return "input/output error";
+    case SPH_ERR_BUDGET: return "sub-step budget exceeded";
     default: return "unknown status";
     }
 }
@@ -2120,6 +2153,9 @@ SPHDEF sph_world_def sph_world_def_default(int dim) {
     d.cfl_force = SPH__R(0.25);
     d.max_compression = SPH__R(0.2);
     d.max_speed = 0;
+    d.max_displacement = 1;
+    d.check_walls = 1;
+    d.max_substeps = 100000;
     d.boundary_pressure = SPH_BP_EXTRAPOLATE;
     d.boundary_volume = SPH_BVOL_GIVEN;
     d.boundary_gamma = 1;
@@ -2253,6 +2289,11 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
                (double)d->max_compression);
     SPH__CHECK(sph__finite((double)d->max_speed) && d->max_speed >= 0,
                "sph_world_def.max_speed = %g: must be finite and >= 0", (double)d->max_speed);
+    SPH__CHECK(sph__finite((double)d->max_displacement) && d->max_displacement >= 0,
+               "sph_world_def.max_displacement = %g: must be finite and >= 0",
+               (double)d->max_displacement);
+    SPH__CHECK(d->max_substeps >= 1 && d->max_substeps <= (1 << 30),
+               "sph_world_def.max_substeps = %d: must be in [1, 2^30]", d->max_substeps);
     for (k = 0; k < d->dim; ++k) {
         SPH__CHECK(sph__finite((double)d->domain_lo[k]) && sph__finite((double)d->domain_hi[k]) &&
                        d->domain_lo[k] <= d->domain_hi[k],
@@ -2274,6 +2315,28 @@ static sph_real sph__lattice_sum(const sph_kernel* k, sph_real dx) {
         for (j = (D > 1 ? -R : 0); j <= (D > 1 ? R : 0); ++j)
             for (l = (D > 2 ? -R : 0); l <= (D > 2 ? R : 0); ++l)
                 sum += (double)sph_kernel_w(k, dx * sph__sqrt((sph_real)(i * i + j * j + l * l)));
+    return (sph_real)(sum * vol);
+}
+
+/* The wall volume fraction that check_walls allows (see sph__wall_fraction): that of a particle
+   half a spacing past the first layer of a flat lattice wall, 1 dx past its face (0.94 for
+   Wendland C2 at h = 1.3 dx in 2D and 3D). A fluid particle stays well below it: 0.5 on a face,
+   0.39 in a 2D corner half a spacing from both faces, 0.75 at a 2D corner point and 0.875 at a
+   3D one; on the first layer's line the fraction is 0.79. */
+static sph_real sph__wall_fraction_limit(const sph_kernel* k, sph_real dx) {
+    const int R = (int)(k->radius / dx) + 2, D = k->dim;
+    double sum = 0, vol = 1;
+    int i, j, l;
+    for (i = 0; i < D; ++i) vol *= (double)dx;
+    /* the particle at the origin; the wall's layers at x = 0.5, -0.5, -1.5 ... spacings, the
+       lattice along the wall offset by half a spacing */
+    for (i = -R; i <= 0; ++i)
+        for (j = (D > 1 ? -R : 0); j <= (D > 1 ? R : 0); ++j)
+            for (l = (D > 2 ? -R : 0); l <= (D > 2 ? R : 0); ++l) {
+                const double x = (i + 0.5) * (double)dx, y = D > 1 ? (j + 0.5) * (double)dx : 0,
+                             z = D > 2 ? (l + 0.5) * (double)dx : 0;
+                sum += (double)sph_kernel_w(k, (sph_real)sqrt(x * x + y * y + z * z));
+            }
     return (sph_real)(sum * vol);
 }
 
@@ -2305,6 +2368,7 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
                          "sph_world_def.spacing = %g: h = %g m gives kernel constants that are "
                          "not finite and > 0 in sph_real", (double)def->spacing, (double)w->h);
     w->priv.lattice_sum = sph__lattice_sum(&w->kernel, w->dx);
+    w->priv.wall_fraction_max = sph__wall_fraction_limit(&w->kernel, w->dx) / w->priv.lattice_sum;
     for (k = 0; k < def->dim; ++k) {
         per[k] = def->periodic[k] != 0;
         lo[k] = def->domain_lo[k];
@@ -2365,6 +2429,8 @@ SPHDEF void sph_world_free(sph_world* w) {
     SPH_FREE(w->priv.bpq);
     SPH_FREE(w->priv.soc);
     SPH_FREE(w->priv.socw);
+    SPH_FREE(w->priv.snap[0]);
+    SPH_FREE(w->priv.snap[1]);
     sph_grid_free(&w->priv.sgrid);
     sph_neighbors_free(&w->priv.snl);
     memset(w, 0, sizeof(*w));
@@ -3876,7 +3942,31 @@ static sph_status sph__boundary_motion(sph_world* w, double t) {
 enum { SPH__RED_KE, SPH__RED_ERRSUM, SPH__RED_ERRMAX, SPH__RED_COMP, SPH__RED_V2MAX,
        SPH__RED_A2MAX, SPH__RED_OUT, SPH__RED_BAD, SPH__RED_KIND, SPH__RED_N };
 enum { SPH__BAD_NONE, SPH__BAD_NONFINITE, SPH__BAD_DENSITY, SPH__BAD_COMPRESSION, SPH__BAD_SPEED,
-       SPH__BAD_ENERGY };
+       SPH__BAD_ENERGY, SPH__BAD_DISPLACEMENT, SPH__BAD_WALL };
+
+static int sph__incompressible(int solver) {
+    return solver != SPH_SOLVER_WCSPH && solver != SPH_SOLVER_COMPRESSIBLE;
+}
+
+/* check_walls: the wall volume fraction sum_b V_b W_ib / S of fluid particle i (S the lattice
+   sum, so a particle deep inside a lattice wall has 1 and one on a flat wall's face 0.5), from
+   the step's fluid->wall lists at the particle's position now. */
+static sph_real sph__wall_fraction(const sph__ctx* c, const sph_real* xi, size_t i, sph_real S) {
+    const int D = c->dim;
+    sph_real sum = 0;
+    size_t kk, k0 = c->fb->begin[i], k1 = k0 + c->fb->count[i];
+    for (kk = k0; kk < k1; ++kk) {
+        const size_t b = c->fb->idx[kk];
+        sph_real d[3] = {0, 0, 0}, r2 = 0;
+        int k;
+        sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
+        for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+        sum += c->bvol[b] * sph__kw(c->k.form, sph__sqrt(r2) * c->k.inv_h);
+    }
+    return sum * c->k.norm_w / S;
+}
+
+
 
 static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph_real* acc,
                                       sph_real kv, sph_real kr, sph_real kx, int final) {
@@ -3884,6 +3974,12 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
     sph_real vlim = w->def.max_speed;
     double red[SPH__RED_N];
+    /* the largest distance a particle may cover in one step at its final speed [m], and the
+       wall fraction check_walls allows (lattice walls of given volumes only) */
+    const double dmax = (double)w->def.max_displacement * (double)w->dx,
+                 dt2 = w->stats.dt * w->stats.dt;
+    const int walls = final && w->def.check_walls && c->has_b && w->nb > 0 &&
+                      w->def.boundary_volume == SPH_BVOL_GIVEN && w->priv.wall_fraction_max > 0;
     sph__idx blk;
     size_t q;
     int k;
@@ -3894,6 +3990,20 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
            piston, an expansion into vacuum reaches 2 c0/(gamma - 1) = 5 c0 for air): there
            only a runaway is a blow-up */
         if (w->priv.solver == SPH_SOLVER_COMPRESSIBLE) vlim *= 10;
+        /* the incompressible solvers have no sound speed that bounds the flow: the automatic c0
+           is 10 max(sqrt(2 |g| H), |v|max), so 0.3 c0 is three times the free-fall speed over the
+           fluid's height; walls move the fluid at up to twice their speed (a piston's reflected
+           wave), which is added */
+        if (sph__incompressible(w->priv.solver) && vlim > 0) {
+            double vb2 = 0;
+            size_t b;
+            for (b = 0; b < w->nb * (size_t)D; b += (size_t)D) {
+                double v2 = 0;
+                for (k = 0; k < D; ++k) v2 += (double)w->b_v[b + (size_t)k] * (double)w->b_v[b + (size_t)k];
+                if (v2 > vb2) vb2 = v2;
+            }
+            vlim = (sph_real)(0.3 * (double)vlim + 2 * sqrt(vb2));
+        }
     }
     if (nblk * SPH__RED_N > w->priv.block_cap) {
         size_t cap = nblk * SPH__RED_N + 64;
@@ -3952,6 +4062,10 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                      !c->pc[w->phase[i]].gas)
                 bad = SPH__BAD_COMPRESSION;
             else if (vlim > 0 && v2 > (double)vlim * (double)vlim) bad = SPH__BAD_SPEED;
+            else if (dmax > 0 && v2 * dt2 > dmax * dmax) bad = SPH__BAD_DISPLACEMENT;
+            else if (walls && c->fb->count[i] > 0 &&
+                     sph__wall_fraction(c, xi, i, w->priv.lattice_sum) > w->priv.wall_fraction_max)
+                bad = SPH__BAD_WALL;
             r[SPH__RED_KE] += 0.5 * mi * v2;
             r[SPH__RED_ERRSUM] += fabs(err);
             if (err > 0) r[SPH__RED_COMP] += err;
@@ -4020,6 +4134,24 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                              "real sound speed",
                              (unsigned long long)w->steps, w->time, i, (unsigned)w->id[i],
                              (double)c->e[i], (double)w->rho[i]);
+        case SPH__BAD_DISPLACEMENT:
+            return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
+                             "step %llu (t = %g s): fluid particle %zu (id %u) moves %g spacings "
+                             "per step (%g m/s at dt = %g s; max_displacement %g): the step is "
+                             "too large for this speed, a particle could cross a wall",
+                             (unsigned long long)w->steps, w->time, i, (unsigned)w->id[i],
+                             sqrt(v2 * dt2) / (double)w->dx, sqrt(v2), w->stats.dt,
+                             (double)w->def.max_displacement);
+        case SPH__BAD_WALL:
+            return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
+                             "step %llu (t = %g s): fluid particle %zu (id %u) at (%g, %g, %g) is "
+                             "inside the wall layers (wall volume fraction %g > %g): it crossed "
+                             "a wall", (unsigned long long)w->steps, w->time, i,
+                             (unsigned)w->id[i], (double)w->x[i * (size_t)D],
+                             D > 1 ? (double)w->x[i * (size_t)D + 1] : 0.0,
+                             D > 2 ? (double)w->x[i * (size_t)D + 2] : 0.0,
+                             (double)sph__wall_fraction(c, w->x + i * (size_t)D, i, w->priv.lattice_sum),
+                             (double)w->priv.wall_fraction_max);
         default:
             return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
                              "step %llu (t = %g s): fluid particle %zu (id %u) moves at %g m/s, "
@@ -4034,6 +4166,18 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
 static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, sph_real kr,
                                  sph_real kx, int final) {
     return sph__integrate_with(w, c, w->a, kv, kr, kx, final);
+}
+
+/* The end of an iterative solve above its tolerance: the step was taken with the last pressure,
+   and the caller hears of it (sph_advance undoes the step and retries a smaller one). */
+static sph_status sph__not_converged(sph_world* w, const char* solver, int it, double err,
+                                     double errmax) {
+    return sph__fail(w, SPH_ERR_NOT_CONVERGED, -1,
+                     "step %llu (t = %g s): %s stopped at max_iterations = %d with a mean "
+                     "compression of %g (tolerance %g; largest %g): the step was taken with the "
+                     "last pressure; a smaller dt converges faster",
+                     (unsigned long long)w->steps, w->time, solver, it, err,
+                     (double)w->def.tolerance, errmax);
 }
 
 /* Room for the per-block reductions of any step of the world's n particles (sph__integrate_with's
@@ -5002,6 +5146,9 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
     s = sph__integrate(w, &c, 0, 0, drift, 1);
     sph__time(w, SPH_STAGE_INTEGRATE, &t0);
     w->stats.step_time = sph__now() - tstart;
+    if (s == SPH_OK && (err > (double)w->def.tolerance ||
+                        (w->def.tolerance_max > 0 && errmax > (double)w->def.tolerance_max)))
+        s = sph__not_converged(w, "PCISPH", it, err, errmax);
     return s;
 }
 
@@ -5133,9 +5280,10 @@ SPH__INLINE double sph__iisph_update_one(sph_world* w, const sph__ctx* c, size_t
     return err > 0 ? (double)err : 0.0;
 }
 
-/* One Jacobi sweep over all particles; returns the mean predicted compression (fixed-order block
-   sums, so the iteration count does not depend on the thread count). */
-static double sph__iisph_sweep(sph_world* w, const sph__ctx* c, sph_real dt) {
+/* One Jacobi sweep over all particles; returns the mean predicted compression and, in *emax, the
+   largest (fixed-order block sums, so the iteration count does not depend on the thread
+   count). */
+static double sph__iisph_sweep(sph_world* w, const sph__ctx* c, sph_real dt, double* emax) {
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
     const sph_real omega = w->def.omega;
     double sum = 0;
@@ -5145,14 +5293,23 @@ static double sph__iisph_sweep(sph_world* w, const sph__ctx* c, sph_real dt) {
     for (blk = 0; blk < (sph__idx)nblk; ++blk) {
         const size_t i0 = (size_t)blk * SPH__BLOCK;
         const size_t i1 = i0 + SPH__BLOCK < w->n ? i0 + SPH__BLOCK : w->n;
-        double e = 0;
+        double e = 0, m = 0, ei;
         size_t i;
-        if (c->dim == 2) for (i = i0; i < i1; ++i) e += sph__iisph_update_one(w, c, i, 2, dt, omega);
-        else if (c->dim == 3) for (i = i0; i < i1; ++i) e += sph__iisph_update_one(w, c, i, 3, dt, omega);
-        else for (i = i0; i < i1; ++i) e += sph__iisph_update_one(w, c, i, 1, dt, omega);
-        w->priv.block[blk] = e;
+        for (i = i0; i < i1; ++i) {
+            ei = c->dim == 2   ? sph__iisph_update_one(w, c, i, 2, dt, omega)
+                 : c->dim == 3 ? sph__iisph_update_one(w, c, i, 3, dt, omega)
+                               : sph__iisph_update_one(w, c, i, 1, dt, omega);
+            e += ei;
+            if (ei > m) m = ei;
+        }
+        w->priv.block[2 * (size_t)blk] = e;
+        w->priv.block[2 * (size_t)blk + 1] = m;
     }
-    for (q = 0; q < nblk; ++q) sum += w->priv.block[q];
+    *emax = 0;
+    for (q = 0; q < nblk; ++q) {
+        sum += w->priv.block[2 * q];
+        if (w->priv.block[2 * q + 1] > *emax) *emax = w->priv.block[2 * q + 1];
+    }
     return w->n ? sum / (double)w->n : 0;
 }
 
@@ -5167,7 +5324,7 @@ static void sph__iisph_pressure_acceleration(sph_world* w, const sph__ctx* c) {
 
 static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
-    double t0 = sph__now(), tstart = t0, err = 0;
+    double t0 = sph__now(), tstart = t0, err = 0, errmax = 0;
     sph__ctx c;
     sph_status s;
     sph__idx i;
@@ -5176,10 +5333,10 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
         (s = sph__scratch(w, &w->priv.src, w->capacity)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.ap, w->capacity * (size_t)w->dim)) != SPH_OK)
         return s;
-    if (nblk > w->priv.block_cap) {
-        if (!sph__grow((void**)&w->priv.block, nblk + 64, sizeof(double)))
+    if (2 * nblk > w->priv.block_cap) {
+        if (!sph__grow((void**)&w->priv.block, 2 * nblk + 64, sizeof(double)))
             return sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory (reduction blocks)");
-        w->priv.block_cap = nblk + 64;
+        w->priv.block_cap = 2 * nblk + 64;
     }
     s = sph__boundary_motion(w, w->time);
     if (s != SPH_OK) return s;
@@ -5217,9 +5374,10 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
     /* relaxed Jacobi on the pressure */
     for (;;) {
         sph__iisph_pressure_acceleration(w, &c);
-        err = sph__iisph_sweep(w, &c, dt);
+        err = sph__iisph_sweep(w, &c, dt, &errmax);
         ++it;
-        if ((it >= w->def.min_iterations && err <= (double)w->def.tolerance) ||
+        if ((it >= w->def.min_iterations && err <= (double)w->def.tolerance &&
+             (w->def.tolerance_max <= 0 || errmax <= (double)w->def.tolerance_max)) ||
             it >= w->def.max_iterations)
             break;
     }
@@ -5238,6 +5396,9 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
     s = sph__integrate(w, &c, 0, 0, dt, 1);
     sph__time(w, SPH_STAGE_INTEGRATE, &t0);
     w->stats.step_time = sph__now() - tstart;
+    if (s == SPH_OK && (err > (double)w->def.tolerance ||
+                        (w->def.tolerance_max > 0 && errmax > (double)w->def.tolerance_max)))
+        s = sph__not_converged(w, "IISPH", it, err, errmax);
     return s;
 }
 
@@ -5413,36 +5574,202 @@ SPHDEF sph_status sph_step(sph_world* w, sph_real dt) {
     }
 }
 
+/* sph_advance's rollback: a copy of everything a step changes. The persistent particle arrays
+   of the registry (sph__fluid_arrays: x, v, rho, p, id, phase, drho, and m, e when present), the
+   walls' extrapolated p_b and rho_b (which a host reads), and, when a step may move or re-sort
+   the walls (a motion callback, walls not yet sorted), every persistent wall array; the time,
+   step count, diagnostics and the sort state. Scratch is recomputed by every step. */
+typedef struct sph__snap_head {
+    double time;
+    uint64_t steps, sorts;
+    sph_stats stats;
+    int b_dirty, walls;
+    size_t n, nb;
+} sph__snap_head;
+
+static int sph__snap_arrays(sph_world* w, sph__array* arr, int walls) {
+    sph__array b[16];
+    int n = 0, nb, k;
+    const int na = sph__fluid_arrays(w, b);
+    for (k = 0; k < na; ++k)
+        if (b[k].persistent) arr[n++] = b[k];
+    nb = w->nb > 0 ? sph__boundary_arrays(w, b) : 0;
+    for (k = 0; k < nb; ++k)
+        if ((walls && b[k].persistent) || b[k].ptr == (void**)&w->b_p || b[k].ptr == (void**)&w->b_rho)
+            arr[n++] = b[k];
+    return n;
+}
+
+/* The fluid arrays come first in sph__snap_arrays: entry k is a fluid array for k < nfluid. */
+static int sph__snap_nfluid(sph_world* w) {
+    sph__array b[16];
+    int k, n = 0;
+    const int na = sph__fluid_arrays(w, b);
+    for (k = 0; k < na; ++k) n += b[k].persistent;
+    return n;
+}
+
+static sph_status sph__snapshot_take(sph_world* w, int slot) {
+    sph__array arr[32];
+    sph__snap_head head;
+    const int walls = w->nb > 0 && (w->def.boundary_motion != NULL || w->priv.b_dirty);
+    const int na = sph__snap_arrays(w, arr, walls), nf = sph__snap_nfluid(w);
+    size_t bytes = sizeof(head), pos;
+    int k;
+    for (k = 0; k < na; ++k) bytes += (k < nf ? w->n : w->nb) * arr[k].elem;
+    if (bytes > w->priv.snap_cap[slot]) {
+        if (!sph__grow((void**)&w->priv.snap[slot], bytes, 1))
+            return sph__fail(w, SPH_ERR_NOMEM, -1, "sph_advance: out of memory (rollback copy)");
+        w->priv.snap_cap[slot] = bytes;
+    }
+    head.time = w->time;
+    head.steps = w->steps;
+    head.sorts = w->priv.sorts;
+    head.stats = w->stats;
+    head.b_dirty = w->priv.b_dirty;
+    head.walls = walls;
+    head.n = w->n;
+    head.nb = w->nb;
+    memcpy(w->priv.snap[slot], &head, sizeof(head));
+    pos = sizeof(head);
+    for (k = 0; k < na; ++k) {
+        const size_t sz = (k < nf ? w->n : w->nb) * arr[k].elem;
+        if (sz) memcpy(w->priv.snap[slot] + pos, *arr[k].ptr, sz);
+        pos += sz;
+    }
+    return SPH_OK;
+}
+
+/* Puts the world back, bit for bit, to the state of sph__snapshot_take(slot). */
+static void sph__snapshot_restore(sph_world* w, int slot) {
+    sph__array arr[32];
+    sph__snap_head head;
+    int na, nf, k;
+    size_t pos = sizeof(head);
+    memcpy(&head, w->priv.snap[slot], sizeof(head));
+    SPH_ASSERT(head.n == w->n && head.nb == w->nb);
+    na = sph__snap_arrays(w, arr, head.walls);
+    nf = sph__snap_nfluid(w);
+    for (k = 0; k < na; ++k) {
+        const size_t sz = (k < nf ? w->n : w->nb) * arr[k].elem;
+        if (sz) memcpy(*arr[k].ptr, w->priv.snap[slot] + pos, sz);
+        pos += sz;
+    }
+    w->time = head.time;
+    w->steps = head.steps;
+    w->priv.sorts = head.sorts;
+    w->stats = head.stats;
+    w->priv.b_dirty = head.b_dirty;
+    w->priv.snl_valid = 0; /* the second-order scheme's lists name the order that was undone */
+}
+
+/* The step control of sph_advance (DESIGN: "the robust integrator"):
+     dt = dt_factor * sph_stable_dt, shortened to land exactly on the end (a remainder under two
+          steps is split in halves);
+     a sub-step that fails with SPH_ERR_UNSTABLE (blow-up, runaway, a particle through a wall or
+          moving too far) or SPH_ERR_NOT_CONVERGED is undone bit for bit and retried with half
+          the step (dt_factor halves), at most SPH__RETRIES times in a row;
+     after each successful sub-step dt_factor grows by 1.1 back towards 1.
+   The factor is kept in the world, so a scene that needs a smaller step than the rule gives
+   pays for the failed attempts once, not every frame. Any failure that remains, and every other
+   error (out of memory, a bad callback value), puts the world back to the state before the
+   call. The work is bounded by def.max_substeps sub-steps, retries included. */
+#define SPH__RETRIES 12
+
 SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
-    double t_end, remaining;
+    double t_end;
+    int substeps = 0, retries = 0, in_row = 0;
+    double dt_min = 0;
+    sph_status s;
     if (!w) return SPH_ERR_ARG;
     if (!sph__finite((double)duration) || duration < 0)
         return sph__fail(w, SPH_ERR_ARG, -1, "sph_advance: duration = %g: must be finite and >= 0",
                          (double)duration);
     t_end = w->time + (double)duration;
-    remaining = (double)duration;
-    while (remaining > 1e-12 * (fabs(t_end) > 1 ? fabs(t_end) : 1)) {
-        double dt = (double)sph_stable_dt(w, w->def.solver);
-        sph_status s;
+    if (!(t_end > w->time)) return SPH_OK; /* nothing to do at the resolution of w.time */
+    if (!(w->priv.dt_factor > 0) || w->priv.dt_factor > 1) w->priv.dt_factor = 1;
+    s = sph__snapshot_take(w, 0);
+    if (s != SPH_OK) return s;
+    while (w->time < t_end) {
+        double dt, remaining = t_end - w->time, dt_stable;
         int last = 0;
-        if (!(dt > 0)) {
-            if (w->status == SPH_OK) sph__fail(w, SPH_ERR_UNSTABLE, -1, "sph_advance: no stable dt");
-            return w->status;
+        if (substeps >= w->def.max_substeps) {
+            sph__snapshot_restore(w, 0);
+            return sph__fail(w, SPH_ERR_BUDGET, -1,
+                             "sph_advance: %d sub-steps (def.max_substeps) reached %g s short of "
+                             "the end, at a step of %g s; the world is as before the call",
+                             substeps, remaining, w->stats.dt);
         }
-        if (dt < 1e-12 * (double)duration)
-            return sph__fail(w, SPH_ERR_UNSTABLE, -1,
-                             "sph_advance: the stable time step collapsed to %g s at t = %g s", dt,
-                             w->time);
+        dt_stable = (double)sph_stable_dt(w, w->def.solver);
+        if (!(dt_stable > 0)) {
+            char msg[SPH_ERROR_SIZE];
+            s = w->status != SPH_OK ? w->status : SPH_ERR_UNSTABLE;
+            memcpy(msg, w->error, sizeof msg);
+            sph__snapshot_restore(w, 0);
+            return sph__fail(w, s, -1, "sph_advance: no stable step at t = %g s: %s", w->time, msg);
+        }
+        dt = dt_stable * w->priv.dt_factor;
         if (remaining <= dt) { dt = remaining; last = 1; }
         else if (remaining < 2 * dt) dt = 0.5 * remaining; /* no sliver of a last step */
+        if (!(w->time + dt > w->time) || !((sph_real)dt > 0)) {
+            double t = w->time;
+            sph__snapshot_restore(w, 0);
+            return sph__fail(w, SPH_ERR_UNSTABLE, -1,
+                             "sph_advance: the step %g s is below the resolution of the time %g s "
+                             "(or of sph_real); the world is as before the call", dt, t);
+        }
+        if (substeps > 0) { /* the state of this sub-step's start (slot 0 holds the first's) */
+            s = sph__snapshot_take(w, 1);
+            if (s != SPH_OK) {
+                sph__snapshot_restore(w, 0);
+                return s;
+            }
+        }
+        ++substeps;
         s = sph_step(w, (sph_real)dt);
-        if (s != SPH_OK) return s;
-        /* The step meant to land on t_end is the last: with float steps the rounding may leave
-           a residue of 1e-7 dt, and a sliver step would make the incompressible solvers correct
-           the standing density error in no time at all. */
-        if (last) break;
-        remaining = t_end - w->time;
+        if (s == SPH_OK) {
+            if (dt_min == 0 || dt < dt_min) dt_min = dt;
+            in_row = 0;
+            w->priv.dt_factor = fmin(1.0, 1.1 * w->priv.dt_factor);
+            /* land exactly on the end: a float step, or time + dt rounded, may leave a residue
+               that a sliver step would make the incompressible solvers treat as a real step */
+            if (last) w->time = t_end;
+            continue;
+        }
+        if ((s == SPH_ERR_UNSTABLE || s == SPH_ERR_NOT_CONVERGED) && in_row < SPH__RETRIES) {
+            sph__snapshot_restore(w, substeps > 1 ? 1 : 0);
+            ++retries;
+            ++in_row;
+            w->priv.dt_factor = 0.5 * fmin(w->priv.dt_factor, dt / dt_stable);
+            continue;
+        }
+        {
+            char msg[SPH_ERROR_SIZE];
+            const long idx = w->error_index;
+            double t;
+            memcpy(msg, w->error, sizeof msg);
+            sph__snapshot_restore(w, 0);
+            w->stats.substeps = substeps;
+            w->stats.retries = retries;
+            w->stats.dt_min = dt_min;
+            w->stats.dt_factor = w->priv.dt_factor;
+            t = w->time;
+            if (s == SPH_ERR_UNSTABLE || s == SPH_ERR_NOT_CONVERGED)
+                return sph__fail(w, s, idx,
+                                 "sph_advance: the sub-step failed %d times in a row, the last "
+                                 "at dt = %g s (%g of the stable step); the world is as before "
+                                 "the call (t = %g s). Last failure: %s",
+                                 in_row + 1, dt, dt / dt_stable, t, msg);
+            w->status = s; /* other errors keep their own message */
+            memcpy(w->error, msg, sizeof msg);
+            w->error_index = idx;
+            return s;
+        }
     }
+    w->stats.substeps = substeps;
+    w->stats.retries = retries;
+    w->stats.dt_min = dt_min;
+    w->stats.dt_factor = w->priv.dt_factor;
     return SPH_OK;
 }
 
