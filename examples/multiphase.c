@@ -1,6 +1,6 @@
 /* multiphase.c - two fluids: the Rayleigh-Taylor instability, a heavy fluid (density 1.8) over a
    light one (1.0) in a closed 1 x 2 box under gravity g = 1, with a wavy interface, Re = 420
-   (scene_rayleigh_taylor in examples/scenes.h; seed 000 sec. 5.4). WCSPH.
+   (scene_rayleigh_taylor in examples/scenes.h; Enhanced PCISPH 2018 sec. 5.4). WCSPH.
 
    Two phases are two sph_world_add_phase calls; each particle carries its phase (w.phase[i]) and,
    since the two rest densities differ at equal spacing, its own mass (w.m[i]). Across a density
