@@ -135,7 +135,7 @@ install:
 	sed -e 's|@SPH_PC_PREFIX@|$(PREFIX)|' -e 's|@SPH_PC_INCLUDEDIR@|$(PREFIX)/include|' \
 	    -e "s|@SPH_PC_VERSION@|$$v|" sph.pc.in > $(DESTDIR)$(PREFIX)/share/pkgconfig/sph.pc
 
-$(B)/%: examples/%.c sph.h examples/scenes.h examples/image.h | $(B)
+$(B)/%: examples/%.c sph.h examples/scenes.h examples/image.h examples/draw.h | $(B)
 	$(CC) $(CFLAGS) $(OMP) -I. $< -o $@ -lm
 
 $(B):
