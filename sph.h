@@ -896,6 +896,10 @@ typedef struct sph_world {
     sph_real* e;               /* [n] specific internal energy [J/kg]; NULL unless a phase has a
                                   gas equation of state (then sph_step_compressible evolves it)  */
     uint32_t next_id;          /* id of the next fluid particle added                              */
+    sph_real fill_spacing[3];  /* [m] the spacing per direction that the last successful
+                                  sph_fill_box used: dx, or the nearest spacing that fills its box
+                                  exactly (the particles' mass follows it); 0 before any fill and
+                                  after sph_world_load / _copy (not saved)                       */
 
     /* boundary particles, b = 0 .. nb-1 */
     size_t nb, b_capacity;     /* particles; room in the arrays                                    */
@@ -930,13 +934,17 @@ SPHDEF sph_world_def sph_world_def_default(int dim);
 SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def);
 /* Releases everything the world allocated and zeroes it; NULL is ignored. */
 SPHDEF void sph_world_free(sph_world* w);
-/* Adds a phase (see sph_phase for the checks); returns its index, or -1 with the reason in
-   w->error (SPH_ERR_ARG, SPH_ERR_CAPACITY beyond SPH_MAX_PHASES phases, SPH_ERR_NOMEM). */
+/* Adds a phase (see sph_phase for the checks); returns its index (0, 1, ...), or -1 with the
+   reason in w->error and the status in w->status (SPH_ERR_ARG, SPH_ERR_CAPACITY beyond
+   SPH_MAX_PHASES phases, SPH_ERR_NOMEM). The only adder that returns an index rather than a
+   sph_status: check it for -1 before passing it on. */
 SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase);
 /* Fills the box [lo, hi] with fluid of the phase: round(extent / dx) particles per direction,
    at the spacing that fills the box exactly (dx when the extent is a whole number of spacings),
-   each with the rest density times its cell volume as mass. Particles sit at the cell centres,
-   half a spacing in from the faces, at rest. SPH_ERR_ARG for a bad phase, lo or hi NULL, not
+   each with the rest density times its cell volume as mass. The spacing used per direction is
+   in w->fill_spacing afterwards (an extent of 1.03 dx gets one particle at spacing 1.03 dx and
+   3 % more mass than w->phases[phase].mass; make extents whole multiples of dx to keep dx).
+   Particles sit at the cell centres, half a spacing in from the faces, at rest. SPH_ERR_ARG for a bad phase, lo or hi NULL, not
    finite or hi <= lo, or an extent below half a spacing; SPH_ERR_CAPACITY for a huge box. */
 SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, const sph_real* hi);
 /* Adds n fluid particles at x[i*dim + k] with velocities v (NULL = at rest), density rho0, the
@@ -2488,10 +2496,10 @@ static sph_status sph__reserve(sph_world* w, int boundary, size_t need) {
     return SPH_OK;
 }
 
-static int sph__check_phase(sph_world* w, int phase) {
+static int sph__check_phase(sph_world* w, const char* fn, int phase) {
     if (phase < 0 || phase >= w->nphase) {
-        sph__fail(w, SPH_ERR_ARG, -1, "phase %d does not exist (the world has %d phases)", phase,
-                  w->nphase);
+        sph__fail(w, SPH_ERR_ARG, -1, "%s: phase %d does not exist (the world has %d phases)", fn,
+                  phase, w->nphase);
         return 0;
     }
     return 1;
@@ -2510,12 +2518,15 @@ SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase) {
     if (!w) return -1;
     if (!phase) { sph__fail(w, SPH_ERR_ARG, -1, "sph_world_add_phase: phase is NULL"); return -1; }
     if (w->nphase >= SPH_MAX_PHASES) {
-        sph__fail(w, SPH_ERR_CAPACITY, -1, "a world holds at most %d phases", SPH_MAX_PHASES);
+        sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_world_add_phase: a world holds at most %d phases",
+                  SPH_MAX_PHASES);
         return -1;
     }
     ph = *phase;
 #define SPH__PCHECK(cond, ...)                                                                     \
-    do { if (!(cond)) { sph__fail(w, SPH_ERR_ARG, -1, __VA_ARGS__); return -1; } } while (0)
+    do {                                                                                           \
+        if (!(cond)) { sph__fail(w, SPH_ERR_ARG, -1, "sph_world_add_phase: " __VA_ARGS__); return -1; } \
+    } while (0)
     SPH__PCHECK(sph__finite((double)ph.rest_density) && ph.rest_density > 0,
                 "sph_phase.rest_density = %g: must be finite and > 0", (double)ph.rest_density);
     SPH__PCHECK(sph__finite((double)ph.viscosity) && ph.viscosity >= 0,
@@ -2572,7 +2583,7 @@ SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase) {
     if (gas && !w->priv.has_energy) { /* the internal energy array, from now on */
         size_t i;
         if (!sph__grow((void**)&w->e, w->capacity, sizeof(sph_real))) {
-            sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory for the internal energy array");
+            sph__fail(w, SPH_ERR_NOMEM, -1, "sph_world_add_phase: out of memory for the internal energy array");
             return -1;
         }
         for (i = 0; i < w->n; ++i) w->e[i] = 0;
@@ -2645,7 +2656,7 @@ static sph_status sph__add_fluid_checked(sph_world* w, const char* fn, int phase
                                          const sph_real* rho) {
     size_t bad = 0, dim;
     if (!w) return SPH_ERR_ARG;
-    if (!sph__check_phase(w, phase)) return SPH_ERR_ARG;
+    if (!sph__check_phase(w, fn, phase)) return SPH_ERR_ARG;
     if (n == 0) return SPH_OK;
     if (!x) return sph__fail(w, SPH_ERR_ARG, -1, "%s: x is NULL", fn);
     dim = (size_t)w->dim;
@@ -2701,7 +2712,7 @@ SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, cons
     sph_status s;
     int k;
     if (!w) return SPH_ERR_ARG;
-    if (!sph__check_phase(w, phase)) return SPH_ERR_ARG;
+    if (!sph__check_phase(w, "sph_fill_box", phase)) return SPH_ERR_ARG;
     s = sph__check_box(w, "sph_fill_box", lo, hi);
     if (s != SPH_OK) return s;
     mass = (double)w->phases[phase].mass;
@@ -2735,6 +2746,8 @@ SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, cons
     s = sph__append_fluid(w, phase, total, pts, NULL,
                           k == dim ? w->phases[phase].mass : (sph_real)mass, NULL, NULL);
     SPH_FREE(pts);
+    if (s == SPH_OK)
+        for (k = 0; k < 3; ++k) w->fill_spacing[k] = sp[k];
     return s;
 }
 
