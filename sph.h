@@ -191,7 +191,9 @@ int main(void) {
    b_v (and b_a, the wall acceleration) of moving boundary particles; b_x0 keeps each particle's
    reference position and b_body the tag given when it was added. Loops over particles are
    OpenMP parallel and gather-only (each particle writes only its own values); small worlds run
-   on one thread.
+   on one thread. A step opens several short parallel loops, and OpenMP's default may keep idle
+   threads spinning between them: on a host shared with other work set OMP_WAIT_POLICY=passive
+   in the environment (the repository's Makefile does), or steps can run several times slower.
 
    THREAD SAFETY
    The library keeps no global mutable state. sph_status_string and the sph_kernel_* functions
