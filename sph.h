@@ -113,15 +113,15 @@ int main(void) {
    2009, delta = 0.1), by summation (negative pressures then clamped), or by Ott & Schnetter's
    particle-density continuity for phases of very different density. Viscosity: Monaghan's
    artificial viscosity (alpha = 0.02 by default) and a laminar viscosity per phase (Morris et al.
-   1997 by default, or the 2(d+2) form of seed 000). Time integration: symplectic Euler (default)
-   or Stormer-Verlet (second order in time); both take two neighbour passes per step over one
-   neighbour list (forces, then the density rate with the new velocities, which stable
-   integration of the acoustic waves requires). sph_stable_dt combines the acoustic CFL
+   1997 by default, or the 2(d+2) form of Enhanced PCISPH 2018 eq. 2.5). Time integration:
+   symplectic Euler (default) or Stormer-Verlet (second order in time); both take two neighbour
+   passes per step over one neighbour list (forces, then the density rate with the new velocities,
+   which stable integration of the acoustic waves requires). sph_stable_dt combines the acoustic CFL
    (0.25 h / (c0 + |v|)), the viscous limit (0.125 h^2 / nu) and the force limit
    (0.25 sqrt(h / |a|)); sph_advance(&w, duration) steps with it, landing exactly on the end.
 
    WCSPH, SECOND-ORDER SCHEME (def.scheme = SPH_SCHEME_SECOND_ORDER; periodic domains only)
-   Negi & Ramachandran 2022 (seed 002), L-IPST-C: the fluid density rho (w->rho) is carried by
+   Negi & Ramachandran 2022, L-IPST-C: the fluid density rho (w->rho) is carried by
    continuity with the Bonet-Lok corrected divergence and gives p by the phase's EOS; the
    operators integrate with the Shepard volume 1/sum_j W_ij of the geometry, never m/rho; the
    pressure gradient is the corrected asymmetric form (1/rho_i) sum_j (p_j - p_i) B_i grad W_ij
@@ -136,16 +136,16 @@ int main(void) {
    Taylor-Green). The operators are public (>>operators).
 
    SOLVER: PCISPH (sph_step_pcisph; sph_world_def_pcisph(&def, enhanced) sets it up)
-   Predict-correct loop (Solenthaler & Pajarola 2009, seed 000): pressures are corrected from
-   the predicted density error until its mean is below def.tolerance (the presets use 0.01 % and
-   at least 3 iterations); the last correction moves the particles. enhanced = 0 is the original
+   Predict-correct loop (Solenthaler & Pajarola 2009; Enhanced PCISPH 2018): pressures are corrected
+   from the predicted density error until its mean is below def.tolerance (the presets use 0.01 %
+   and at least 3 iterations); the last correction moves the particles. enhanced = 0 is the original
    (summation density on predicted positions, one gain per phase from a full lattice neighbour-
-   hood). enhanced = 1 is seed 000's engineering version: continuity density with delta-SPH,
-   pressure smoothing (chi = 0.8), extrapolated walls with a Shepard wall density, Stormer-Verlet,
-   a gain per particle from its actual neighbours and the multiphase pressure gradient, warm
-   started from half the last pressure. Each part stays switchable through its def field. With
-   density ratios of 0.2 and below, or interfaces that mix (Rayleigh-Taylor), choose
-   def.density = SPH_DENSITY_PARTICLE (Ott & Schnetter): seed 000's continuity equation lets a
+   hood). enhanced = 1 is Enhanced PCISPH 2018's engineering version: continuity density with
+   delta-SPH, pressure smoothing (chi = 0.8), extrapolated walls with a Shepard wall density,
+   Stormer-Verlet, a gain per particle from its actual neighbours and the multiphase pressure
+   gradient, warm started from half the last pressure. Each part stays switchable through its def
+   field. With density ratios of 0.2 and below, or interfaces that mix (Rayleigh-Taylor), choose
+   def.density = SPH_DENSITY_PARTICLE (Ott & Schnetter 2003): the thesis' continuity equation lets a
    light particle at an interface take its heavy neighbours' masses (the tests show the 0.2 tank
    failing with it and holding with particle density). The original PCISPH cannot hold two phases
    of different density at all (summation smears the mass jump): it fails within a few steps and
@@ -153,7 +153,7 @@ int main(void) {
    zero pressure). delta-SPH uses c = cfl h / dt, the speed for which dt is the acoustic step.
 
    SOLVER: IISPH (sph_step_iisph, or def.solver = SPH_SOLVER_IISPH)
-   Implicit incompressible SPH (Ihmsen et al. 2014, seed 003): summation density, then a pressure
+   Implicit incompressible SPH (Ihmsen et al. 2014; Meiers 2025): summation density, then a pressure
    that makes the predicted density the rest density, by relaxed Jacobi (def.omega = 0.5) from a
    warm start (0.5 of the last pressure), negative pressures clamped, until the mean predicted
    compression is below def.tolerance (0.1 %) after min_iterations (2), at most max_iterations
@@ -191,7 +191,9 @@ int main(void) {
    b_v (and b_a, the wall acceleration) of moving boundary particles; b_x0 keeps each particle's
    reference position and b_body the tag given when it was added. Loops over particles are
    OpenMP parallel and gather-only (each particle writes only its own values); small worlds run
-   on one thread.
+   on one thread. A step opens several short parallel loops, and OpenMP's default may keep idle
+   threads spinning between them: on a host shared with other work set OMP_WAIT_POLICY=passive
+   in the environment (the repository's Makefile does), or steps can run several times slower.
 
    THREAD SAFETY
    The library keeps no global mutable state. sph_status_string and the sph_kernel_* functions
@@ -240,7 +242,7 @@ int main(void) {
    wall-clock time per stage; w.step_time_total and w.stage_time_total accumulate them.
 
    SOLVER: COMPRESSIBLE (sph_step_compressible, or def.solver = SPH_SOLVER_COMPRESSIBLE)
-   Explicit compressible multiphase SPH (Ott & Schnetter 2003, seed 004): density by continuity
+   Explicit compressible multiphase SPH (Ott & Schnetter 2003): density by continuity
    (use def.density = SPH_DENSITY_PARTICLE, eq. 11, when phases of very different density meet),
    momentum by def.pressure_grad (SPH_PGRAD_MULTIPHASE is eq. 12), internal energy w.e [J/kg] by
    eq. 13 written so that total energy is conserved to round-off, Monaghan 1992 artificial
@@ -251,15 +253,66 @@ int main(void) {
    sph_add_fluid / sph_fill_box to the back pressure; the host may overwrite it) and only this
    step accepts them. dt = cfl h / max(c_i + |v_i|). sph_add_fluid_ex takes per-particle masses
    and densities: put equal spacing and unequal masses across a density jump. Validated against
-   seed 004's advection, sound-wave and air | Diesel shock-tube tests, Toro's Riemann solutions
-   and a 1000:1 interface at rest (tests/test_compressible.c). With multiphase walls each phase
-   sees a wall pressure extrapolated from its own particles only.
+   Ott & Schnetter's advection, sound-wave and air | Diesel shock-tube tests, Toro's Riemann
+   solutions and a 1000:1 interface at rest (tests/test_compressible.c). With multiphase walls each
+   phase sees a wall pressure extrapolated from its own particles only.
 
    WHAT IT DOES NOT DO (yet)
    No surface tension, no turbulence model, no rigid-body coupling (boundaries move kinematically),
    no adaptive resolution, no GPU. A 1000:1 interface touching a side wall does not stay at rest
    (the contact line breaks up within 0.2 s); with periodic sides it stays at rest for about 2 s,
    then a slowly growing mode breaks it (tests/test_compressible.c).
+
+   REFERENCES
+   Comments cite these as "Author Year, eq./sec./Table N", numbered as in the work itself.
+   Adami, Hu & Adams 2012: A generalized wall boundary condition for smoothed particle
+       hydrodynamics. J. Comput. Phys.
+   Adami, Hu & Adams 2013: A transport-velocity formulation for smoothed particle hydrodynamics.
+       J. Comput. Phys.
+   Akinci et al. 2012: N. Akinci, M. Ihmsen, G. Akinci, B. Solenthaler, M. Teschner, Versatile
+       rigid-fluid coupling for incompressible SPH. ACM Trans. Graph. (SIGGRAPH).
+   Becker & Teschner 2007: Weakly compressible SPH for free surface flows. Symposium on Computer
+       Animation.
+   Bonet & Lok 1999: Variational and momentum preservation aspects of smooth particle
+       hydrodynamic formulations. Comput. Methods Appl. Mech. Eng.
+   Dehnen & Aly 2012: Improving convergence in smoothed particle hydrodynamics simulations
+       without pairing instability. Mon. Not. R. Astron. Soc.
+   Enhanced PCISPH 2018: "Enhanced PCISPH for engineering applications", master's thesis, 2018,
+       written at ESS Engineering Software Steyr GmbH (the enhancements are credited to
+       C. Peng, K. Szewc, H. Cao and the author; our copy lacks the title page, so the
+       author's name is not given here). Also "the thesis" in the PCISPH comments.
+   Harlow & Amsden 1971: Fluid dynamics. Los Alamos report LA-4700 (stiffened gas).
+   Hu & Adams 2006: A multi-phase SPH method for macroscopic and mesoscopic flows. J. Comput.
+       Phys.
+   Huang et al. 2019: C. Huang, T. Long, S. M. Li, M. B. Liu, A kernel gradient-free SPH method
+       with iterative particle shifting technology for modeling low-Reynolds flows around
+       airfoils. Eng. Anal. Bound. Elem.
+   Ihmsen et al. 2014: M. Ihmsen, J. Cornelis, B. Solenthaler, C. Horvath, M. Teschner,
+       Implicit incompressible SPH. IEEE Trans. Vis. Comput. Graph.
+   Koschier et al. 2020: D. Koschier, J. Bender, B. Solenthaler, M. Teschner, Smoothed particle
+       hydrodynamics techniques for the physics based simulation of fluids and solids
+       (Eurographics 2019 tutorial; arXiv:2009.06944).
+   Meiers 2025: T. Meiers, Incompressible SPH with advanced boundary handling for dynamic and
+       non-uniform boundaries. Bachelor's thesis, University of Freiburg, 2025.
+   Molteni & Colagrossi 2009: A simple procedure to improve the pressure evaluation in
+       hydrodynamic context using the SPH. Comput. Phys. Commun.
+   Monaghan 1992: Smoothed particle hydrodynamics. Annu. Rev. Astron. Astrophys.
+   Monaghan 1994: Simulating free surface flows with SPH. J. Comput. Phys.
+   Monaghan 2005: Smoothed particle hydrodynamics. Rep. Prog. Phys.
+   Morris 1996: Analysis of smoothed particle hydrodynamics with applications. PhD thesis,
+       Monash University.
+   Morris et al. 1997: J. P. Morris, P. J. Fox, Y. Zhu, Modeling low Reynolds number
+       incompressible flows using SPH. J. Comput. Phys.
+   Negi & Ramachandran 2022: P. Negi, P. Ramachandran, Techniques for second order convergent
+       weakly-compressible smoothed particle hydrodynamics schemes without boundaries.
+       arXiv:2107.11859 (v4, 2022).
+   Ott & Schnetter 2003: F. Ott, E. Schnetter, A modified SPH approach for fluids with large
+       density differences. arXiv:physics/0303112.
+   Solenthaler & Pajarola 2009: Predictive-corrective incompressible SPH. ACM Trans. Graph.
+       (SIGGRAPH).
+   Toro: E. F. Toro, Riemann Solvers and Numerical Methods for Fluid Dynamics. Springer.
+   Wendland 1995: Piecewise polynomial, positive definite and compactly supported radial
+       functions of minimal degree. Adv. Comput. Math.
 */
 /* ============================================================================================== */
 /* >>config                                                                                       */
@@ -458,7 +511,7 @@ SPHDEF void sph_neighbors_free(sph_neighbors* nl);
 /* ============================================================================================== */
 
 /* Corrected SPH derivative operators on any point set (Bonet & Lok 1999; Negi & Ramachandran
-   2022, seed 002 Table II), usable without a world. The points x (n of them, stride g->dim) are
+   2022, Table II), usable without a world. The points x (n of them, stride g->dim) are
    those the grid was built on, and nl their lists from sph_neighbors_build(nl, g, x, x, n, k->radius,
    exclude_self = 1); pair vectors follow the grid's periodic directions. vol[i] is the
    integration volume omega_i [m^dim] (sph_op_volume), B the d x d correction matrix of each point
@@ -468,12 +521,12 @@ SPHDEF void sph_neighbors_free(sph_neighbors* nl);
    (tests/test_operators.c). Loops are parallel over points (OpenMP) and deterministic. The
    operators only read their inputs; an output array must not overlap any input. */
 
-/* omega_i = 1 / (W(0) + sum_j W_ij) [m^dim]: the Shepard volume (seed 002 eq. 6). */
+/* omega_i = 1 / (W(0) + sum_j W_ij) [m^dim]: Shepard volume (Negi & Ramachandran 2022 eq. 6). */
 SPHDEF void sph_op_volume(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
                           const sph_real* x, size_t n, sph_real* vol);
-/* B_i = [sum_j omega_j grad W_ij (x) (x_j - x_i)]^-1 (seed 002 eq. 11, Bonet & Lok 1999): makes the
-   gradient exact for linear fields. Returns the number of points whose moment matrix was singular
-   (too few neighbours); theirs is set to the identity. */
+/* B_i = [sum_j omega_j grad W_ij (x) (x_j - x_i)]^-1 (Negi & Ramachandran 2022 eq. 11; Bonet & Lok
+   1999): makes the gradient exact for linear fields. Returns the number of points whose moment
+   matrix was singular (too few neighbours); theirs is set to the identity. */
 SPHDEF size_t sph_op_correction(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
                                 const sph_real* x, const sph_real* vol, size_t n, sph_real* B);
 /* grad f_i = sum_j (f_j - f_i) B_i grad W_ij omega_j  (asym_bc)   -> grad[i * dim + a] [f/m] */
@@ -484,9 +537,9 @@ SPHDEF void sph_op_gradient(const sph_grid* g, const sph_neighbors* nl, const sp
 SPHDEF void sph_op_divergence(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
                               const sph_real* x, const sph_real* vol, const sph_real* B,
                               const sph_real* u, size_t n, sph_real* div);
-/* The iterative particle shifting displacement (Huang et al. 2019; seed 002 eq. 19):
-   dx_i = h sum_j n_ij W_ij omega_j, n_ij = (x_i - x_j)/|x_i - x_j|, which moves a point away from
-   crowded neighbours; repeated with fresh lists it relaxes a set to uniform spacing. [m] */
+/* The iterative particle shifting displacement (Huang et al. 2019; Negi & Ramachandran 2022 eq.
+   19): dx_i = h sum_j n_ij W_ij omega_j, n_ij = (x_i - x_j)/|x_i - x_j|, which moves a point away
+   from crowded neighbours; repeated with fresh lists it relaxes a set to uniform spacing. [m] */
 SPHDEF void sph_op_shift(const sph_grid* g, const sph_neighbors* nl, const sph_kernel* k,
                          const sph_real* x, const sph_real* vol, size_t n, sph_real* dx);
 /* Lap f_i = sum_j (G_j - G_i) . B_i grad W_ij omega_j, G = the corrected gradient of f
@@ -505,18 +558,18 @@ typedef enum sph_solver {
     SPH_SOLVER_WCSPH = 0, /* weakly compressible SPH with an equation of state                */
     SPH_SOLVER_IISPH,     /* implicit incompressible SPH (Ihmsen et al. 2014), relaxed Jacobi  */
     SPH_SOLVER_PCISPH,    /* predictive-corrective incompressible SPH (Solenthaler & Pajarola
-                             2009) and the enhanced multiphase version of seed 000          */
+                             2009) and the enhanced multiphase version of Enhanced PCISPH 2018 */
     SPH_SOLVER_COMPRESSIBLE /* explicit compressible multiphase SPH with an energy equation
-                             (Ott & Schnetter 2003, seed 004): gases, shocks, large density
+                             (Ott & Schnetter 2003): gases, shocks, large density          
                              ratios                                                          */
 } sph_solver;
 
-/* PCISPH's pressure gain (seed 000 sec. 3.1, digest sec. 5.2). */
+/* PCISPH's pressure gain (Solenthaler & Pajarola 2009; Enhanced PCISPH 2018 sec. 3.1, eq. 3.5). */
 typedef enum sph_pcisph_factor {
     SPH_PCISPH_PROTOTYPE = 0, /* one factor per phase from a particle with a full lattice
                                  neighbourhood (Solenthaler & Pajarola 2009, eq. 3.5) (default) */
     SPH_PCISPH_PER_PARTICLE   /* per particle and step from its actual neighbours and masses
-                                 (seed 000 sec. 3.2.4): for multiphase flows                 */
+                                 (Enhanced PCISPH 2018 sec. 3.2.4): for multiphase flows     */
 } sph_pcisph_factor;
 
 typedef enum sph_density {
@@ -545,7 +598,7 @@ typedef enum sph_integrator {
 typedef enum sph_wcsph_scheme {
     SPH_SCHEME_STANDARD = 0, /* the options above: continuity/summation, delta-SPH, artificial and
                                 laminar viscosity, walls (default)                             */
-    SPH_SCHEME_SECOND_ORDER  /* seed 002's L-IPST-C (Negi & Ramachandran 2022): Bonet-Lok
+    SPH_SCHEME_SECOND_ORDER  /* L-IPST-C (Negi & Ramachandran 2022): Bonet-Lok
                                 corrected pressure gradient and divergence, coupled Laplacian
                                 viscosity, fluid density apart from the Shepard volume, RK2
                                 midpoint, iterative shifting every def.shift_every steps with
@@ -558,11 +611,11 @@ typedef enum sph_wcsph_scheme {
 typedef enum sph_viscosity_form {
     SPH_VISC_MORRIS = 0, /* Morris et al. 1997: sum_j m_j (mu_i + mu_j) x_ij.grad W_ij /
                             (rho_i rho_j (r^2 + eta^2)) v_ij; accurate Laplacian (default)      */
-    SPH_VISC_MONAGHAN    /* Monaghan 2005 / seed 000 eq. 2.5: 2(d+2) ... (v_ij.x_ij) grad W_ij;
-                            conserves angular momentum, less accurate on a lattice            */
+    SPH_VISC_MONAGHAN    /* Monaghan 2005 / Enhanced PCISPH 2018 eq. 2.5: 2(d+2) ... (v_ij.x_ij)
+                            grad W_ij; conserves angular momentum, less accurate on a lattice */
 } sph_viscosity_form;
 
-/* How a fluid particle sees the pressure of a wall particle (seed 003 sec. 4.2). */
+/* How a fluid particle sees the pressure of a wall particle (Meiers 2025 sec. 4.2). */
 typedef enum sph_boundary_pressure {
     SPH_BP_EXTRAPOLATE = 0, /* Adami et al. 2012: p_b from the fluid with body force and wall
                                acceleration (default)                                         */
@@ -664,8 +717,8 @@ typedef struct sph_world_def {
     sph_integrator integrator; /* default SPH_INTEGRATOR_SYMPLECTIC_EULER; read by WCSPH and
                                   PCISPH (IISPH and the compressible step: symplectic Euler)    */
     sph_wcsph_scheme scheme;   /* default SPH_SCHEME_STANDARD                                     */
-    int shift_every;           /* SPH_SCHEME_SECOND_ORDER: shift every this many steps (seed 002:
-                                  10, the default); 0 = never; >= 0                              */
+    int shift_every;           /* SPH_SCHEME_SECOND_ORDER: shift every this many steps (Negi &
+                                  Ramachandran 2022: 10, the default); 0 = never; >= 0           */
     sph_pressure_clamp clamp;  /* default SPH_CLAMP_AUTO: summation density sees a deficit at a
                                   free surface, so its negative pressures would pull the surface
                                   into the fluid (Becker & Teschner 2007 clamp them). WCSPH and
@@ -679,7 +732,7 @@ typedef struct sph_world_def {
     sph_wall wall;             /* default SPH_WALL_FREE_SLIP                                      */
     sph_boundary_pressure boundary_pressure; /* default SPH_BP_EXTRAPOLATE                        */
     sph_boundary_volume boundary_volume;     /* default SPH_BVOL_GIVEN                            */
-    sph_real boundary_gamma;   /* Akinci volume factor gamma_1 (seed 003 eq. 27) [-]; default 1;
+    sph_real boundary_gamma;   /* Akinci volume factor gamma_1 (Meiers 2025 eq. 27) [-]; default 1;
                                   (0, 10]; used with SPH_BVOL_AKINCI only                        */
     sph_real cfl;              /* acoustic CFL number for sph_stable_dt (WCSPH, compressible; also
                                   PCISPH's delta-SPH speed cfl h / dt); default 0.25; (0, 1]     */
@@ -707,8 +760,8 @@ typedef struct sph_world_def {
     sph_pcisph_factor pcisph_factor; /* default SPH_PCISPH_PROTOTYPE                             */
     sph_real pcisph_gain;      /* 1 (default): displacement dt^2 F/m of the original paper; 2: the
                                   thesis' dt^2/2 F/m, which doubles the correction; (0, 4]    */
-    sph_real pressure_smoothing; /* PCISPH: chi of p <- chi p + (1 - chi) <p> (seed 000 sec.
-                                  3.2.1); 1 (default) = off, [0, 1]                          */
+    sph_real pressure_smoothing; /* PCISPH: chi of p <- chi p + (1 - chi) <p> (Enhanced PCISPH 2018
+                                  sec. 3.2.1); 1 (default) = off, [0, 1]                     */
     sph_real domain_lo[3];     /* [m] domain box; particles outside are counted in                */
     sph_real domain_hi[3];     /*     w.stats.n_outside. lo == hi in a direction: unbounded there
                                   (default 0, 0: unbounded); finite, lo <= hi                    */
@@ -773,7 +826,7 @@ typedef struct sph_stats {
                                  [-]; the other steps leave it unchanged                         */
     double density_error_avg; /* mean |rho/rho0 - 1| over fluid particles [-]                      */
     double density_error_max; /* max |rho/rho0 - 1| [-]                                           */
-    double compression_avg;   /* mean max(rho/rho0 - 1, 0) [-]: compression only (seed 003 eq. 15) */
+    double compression_avg;   /* mean max(rho/rho0 - 1, 0) [-]: compression only (Meiers 2025 eq. 15) */
     double v_max;             /* largest fluid speed [m/s]                                         */
     double a_max;             /* largest acceleration of the step [m/s^2]                          */
     double kinetic_energy;    /* sum 1/2 m |v|^2 [J]                                               */
@@ -877,6 +930,10 @@ typedef struct sph_world {
     sph_real* e;               /* [n] specific internal energy [J/kg]; NULL unless a phase has a
                                   gas equation of state (then sph_step_compressible evolves it)  */
     uint32_t next_id;          /* id of the next fluid particle added                              */
+    sph_real fill_spacing[3];  /* [m] the spacing per direction that the last successful
+                                  sph_fill_box used: dx, or the nearest spacing that fills its box
+                                  exactly (the particles' mass follows it); 0 before any fill and
+                                  after sph_world_load / _copy (not saved)                       */
 
     /* boundary particles, b = 0 .. nb-1 */
     size_t nb, b_capacity;     /* particles; room in the arrays                                    */
@@ -911,13 +968,17 @@ SPHDEF sph_world_def sph_world_def_default(int dim);
 SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def);
 /* Releases everything the world allocated and zeroes it; NULL is ignored. */
 SPHDEF void sph_world_free(sph_world* w);
-/* Adds a phase (see sph_phase for the checks); returns its index, or -1 with the reason in
-   w->error (SPH_ERR_ARG, SPH_ERR_CAPACITY beyond SPH_MAX_PHASES phases, SPH_ERR_NOMEM). */
+/* Adds a phase (see sph_phase for the checks); returns its index (0, 1, ...), or -1 with the
+   reason in w->error and the status in w->status (SPH_ERR_ARG, SPH_ERR_CAPACITY beyond
+   SPH_MAX_PHASES phases, SPH_ERR_NOMEM). The only adder that returns an index rather than a
+   sph_status: check it for -1 before passing it on. */
 SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase);
 /* Fills the box [lo, hi] with fluid of the phase: round(extent / dx) particles per direction,
    at the spacing that fills the box exactly (dx when the extent is a whole number of spacings),
-   each with the rest density times its cell volume as mass. Particles sit at the cell centres,
-   half a spacing in from the faces, at rest. SPH_ERR_ARG for a bad phase, lo or hi NULL, not
+   each with the rest density times its cell volume as mass. The spacing used per direction is
+   in w->fill_spacing afterwards (an extent of 1.03 dx gets one particle at spacing 1.03 dx and
+   3 % more mass than w->phases[phase].mass; make extents whole multiples of dx to keep dx).
+   Particles sit at the cell centres, half a spacing in from the faces, at rest. SPH_ERR_ARG for a bad phase, lo or hi NULL, not
    finite or hi <= lo, or an extent below half a spacing; SPH_ERR_CAPACITY for a huge box. */
 SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, const sph_real* hi);
 /* Adds n fluid particles at x[i*dim + k] with velocities v (NULL = at rest), density rho0, the
@@ -1000,9 +1061,9 @@ SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt);
 /* Settings for PCISPH in def: enhanced = 0 gives the original solver of Solenthaler & Pajarola
    2009 (summation density on predicted positions, prototype factor, no diffusion or smoothing,
    walls without extrapolated pressure, symplectic Euler); enhanced = 1 the engineering version of
-   seed 000 sec. 3.2 (continuity density with delta-SPH, pressure smoothing chi = 0.8, Adami walls
-   with the Shepard wall density, Stormer-Verlet, per-particle factor and the multiphase pressure
-   gradient). Each switch remains a def field to change afterwards. Both also set solver =
+   Enhanced PCISPH 2018 sec. 3.2 (continuity density with delta-SPH, pressure smoothing chi = 0.8,
+   Adami walls with the Shepard wall density, Stormer-Verlet, per-particle factor and the multiphase
+   pressure gradient). Each switch remains a def field to change afterwards. Both also set solver =
    SPH_SOLVER_PCISPH, tolerance = 1e-4, min_iterations = 3 and warm_start (0 original, 0.5
    enhanced). def NULL is ignored. */
 SPHDEF void sph_world_def_pcisph(sph_world_def* def, int enhanced);
@@ -1016,7 +1077,7 @@ SPHDEF sph_status sph_step_pcisph(sph_world* w, sph_real dt);
 /* >>iisph                                                                                        */
 /* ============================================================================================== */
 
-/* One implicit incompressible step of dt [s] (Ihmsen et al. 2014; seed 003): the pressure makes
+/* One implicit incompressible step of dt [s] (Ihmsen et al. 2014; Meiers 2025): the pressure makes
    the predicted density rest density to def.tolerance on average. w->stats.iterations and
    .solver_error report the solve. On SPH_ERR_ARG the world is unchanged (but see
    sph_boundary_fn). */
@@ -1026,7 +1087,7 @@ SPHDEF sph_status sph_step_iisph(sph_world* w, sph_real dt);
 /* >>compressible                                                                                 */
 /* ============================================================================================== */
 
-/* One explicit compressible step of dt [s] (Ott & Schnetter 2003, seed 004): density by the
+/* One explicit compressible step of dt [s] (Ott & Schnetter 2003): density by the
    def.density option (SPH_DENSITY_PARTICLE, eq. 11, for phases of very different density), the
    momentum equation (eq. 12 with def.pressure_grad = SPH_PGRAD_MULTIPHASE), the internal energy
    equation (eq. 13) and Monaghan's (1992) artificial viscosity with def.alpha, def.beta and each
@@ -1335,7 +1396,7 @@ SPHDEF sph_real sph_kernel_support(sph_kernel_type type) {
 
 SPHDEF sph_real sph_kernel_default_h_factor(sph_kernel_type type) {
     switch (type) {
-    case SPH_KERNEL_QUINTIC: return SPH__R(1.2); /* seed 002: h = 1.2 dx, support 3.6 dx     */
+    case SPH_KERNEL_QUINTIC: return SPH__R(1.2); /* Negi & Ramachandran 2022: h = 1.2 dx   */
     case SPH_KERNEL_GAUSSIAN: return SPH__R(1.0);
     case SPH_KERNEL_WENDLAND_C4: return SPH__R(1.5);
     case SPH_KERNEL_WENDLAND_C6: return SPH__R(1.6);
@@ -2144,7 +2205,7 @@ SPHDEF sph_world_def sph_world_def_default(int dim) {
     d.integrator = SPH_INTEGRATOR_SYMPLECTIC_EULER;
     d.scheme = SPH_SCHEME_STANDARD;
     d.shift_every = 10;
-    d.delta = SPH__R(0.1);  /* Molteni & Colagrossi 2009; seed 000 sec. 3.2.1: "usually 0.1" */
+    d.delta = SPH__R(0.1);  /* Molteni & Colagrossi 2009; Enhanced PCISPH 2018 sec. 3.2.1: "usually 0.1" */
     d.alpha = SPH__R(0.02);
     d.beta = 0;
     d.wall = SPH_WALL_FREE_SLIP;
@@ -2159,11 +2220,11 @@ SPHDEF sph_world_def sph_world_def_default(int dim) {
     d.boundary_pressure = SPH_BP_EXTRAPOLATE;
     d.boundary_volume = SPH_BVOL_GIVEN;
     d.boundary_gamma = 1;
-    d.cfl_velocity = SPH__R(0.4); /* seed 003 eq. 14 */
-    d.tolerance = SPH__R(0.001);  /* 0.1 % mean compression, seed 003 */
+    d.cfl_velocity = SPH__R(0.4); /* Meiers 2025 eq. 14 */
+    d.tolerance = SPH__R(0.001);  /* 0.1 % mean compression, Meiers 2025 */
     d.min_iterations = 2;
     d.max_iterations = 100;
-    d.omega = SPH__R(0.5);        /* Ihmsen et al. 2014; seed 003 */
+    d.omega = SPH__R(0.5);        /* Ihmsen et al. 2014; Meiers 2025 */
     d.warm_start = SPH__R(0.5);   /* Ihmsen et al. 2014 */
     d.tolerance_max = 0;
     d.pcisph_factor = SPH_PCISPH_PROTOTYPE;
@@ -2176,11 +2237,11 @@ SPHDEF void sph_world_def_pcisph(sph_world_def* def, int enhanced) {
     if (!def) return;
     def->solver = SPH_SOLVER_PCISPH;
     /* Solenthaler & Pajarola iterate at least 3 times; 0.01 % mean density error is the
-       SPlisHSPlasH default (digest sec. 5.2). A looser tolerance leaves the fluid resting on a
-       standing compression near the tolerance, which keeps it oscillating. */
+       SPlisHSPlasH default (its PCISPH maxError = 0.01 %). A looser tolerance leaves the fluid
+       resting on a standing compression near the tolerance, which keeps it oscillating. */
     def->min_iterations = 3;
     def->tolerance = SPH__R(1e-4);
-    if (enhanced) { /* seed 000 sec. 3.2 (a)-(e) */
+    if (enhanced) { /* Enhanced PCISPH 2018 sec. 3.2 (a)-(e) */
         def->density = SPH_DENSITY_CONTINUITY;
         def->delta = SPH__R(0.1);
         def->pressure_smoothing = SPH__R(0.8);
@@ -2189,7 +2250,7 @@ SPHDEF void sph_world_def_pcisph(sph_world_def* def, int enhanced) {
         def->pcisph_factor = SPH_PCISPH_PER_PARTICLE;
         def->pressure_grad = SPH_PGRAD_MULTIPHASE;
         def->warm_start = SPH__R(0.5);
-    } else { /* Solenthaler & Pajarola 2009 (seed 000 Alg. 5) */
+    } else { /* Solenthaler & Pajarola 2009 (Enhanced PCISPH 2018 Alg. 5) */
         def->warm_start = 0;
         def->density = SPH_DENSITY_SUMMATION;
         def->delta = 0;
@@ -2210,7 +2271,7 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
     SPH__CHECK(d->dim >= 1 && d->dim <= 3, "sph_world_def.dim = %d: must be 1, 2 or 3", d->dim);
     SPH__CHECK(sph__finite((double)d->spacing) && d->spacing > 0,
                "sph_world_def.spacing = %g: must be finite and > 0", (double)d->spacing);
-    /* up to 100: 1D studies use h = 20 dx (seed 004's sound wave) */
+    /* up to 100: 1D studies use h = 20 dx (Ott & Schnetter 2003's sound wave) */
     SPH__CHECK(sph__finite((double)d->h_factor) && d->h_factor >= 0 && d->h_factor <= 100,
                "sph_world_def.h_factor = %g: must be 0 (kernel default) or in (0, 100]",
                (double)d->h_factor);
@@ -2503,10 +2564,10 @@ static sph_status sph__reserve(sph_world* w, int boundary, size_t need) {
     return SPH_OK;
 }
 
-static int sph__check_phase(sph_world* w, int phase) {
+static int sph__check_phase(sph_world* w, const char* fn, int phase) {
     if (phase < 0 || phase >= w->nphase) {
-        sph__fail(w, SPH_ERR_ARG, -1, "phase %d does not exist (the world has %d phases)", phase,
-                  w->nphase);
+        sph__fail(w, SPH_ERR_ARG, -1, "%s: phase %d does not exist (the world has %d phases)", fn,
+                  phase, w->nphase);
         return 0;
     }
     return 1;
@@ -2525,12 +2586,15 @@ SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase) {
     if (!w) return -1;
     if (!phase) { sph__fail(w, SPH_ERR_ARG, -1, "sph_world_add_phase: phase is NULL"); return -1; }
     if (w->nphase >= SPH_MAX_PHASES) {
-        sph__fail(w, SPH_ERR_CAPACITY, -1, "a world holds at most %d phases", SPH_MAX_PHASES);
+        sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_world_add_phase: a world holds at most %d phases",
+                  SPH_MAX_PHASES);
         return -1;
     }
     ph = *phase;
 #define SPH__PCHECK(cond, ...)                                                                     \
-    do { if (!(cond)) { sph__fail(w, SPH_ERR_ARG, -1, __VA_ARGS__); return -1; } } while (0)
+    do {                                                                                           \
+        if (!(cond)) { sph__fail(w, SPH_ERR_ARG, -1, "sph_world_add_phase: " __VA_ARGS__); return -1; } \
+    } while (0)
     SPH__PCHECK(sph__finite((double)ph.rest_density) && ph.rest_density > 0,
                 "sph_phase.rest_density = %g: must be finite and > 0", (double)ph.rest_density);
     SPH__PCHECK(sph__finite((double)ph.viscosity) && ph.viscosity >= 0,
@@ -2587,7 +2651,7 @@ SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase) {
     if (gas && !w->priv.has_energy) { /* the internal energy array, from now on */
         size_t i;
         if (!sph__grow((void**)&w->e, w->capacity, sizeof(sph_real))) {
-            sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory for the internal energy array");
+            sph__fail(w, SPH_ERR_NOMEM, -1, "sph_world_add_phase: out of memory for the internal energy array");
             return -1;
         }
         for (i = 0; i < w->n; ++i) w->e[i] = 0;
@@ -2660,7 +2724,7 @@ static sph_status sph__add_fluid_checked(sph_world* w, const char* fn, int phase
                                          const sph_real* rho) {
     size_t bad = 0, dim;
     if (!w) return SPH_ERR_ARG;
-    if (!sph__check_phase(w, phase)) return SPH_ERR_ARG;
+    if (!sph__check_phase(w, fn, phase)) return SPH_ERR_ARG;
     if (n == 0) return SPH_OK;
     if (!x) return sph__fail(w, SPH_ERR_ARG, -1, "%s: x is NULL", fn);
     dim = (size_t)w->dim;
@@ -2716,7 +2780,7 @@ SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, cons
     sph_status s;
     int k;
     if (!w) return SPH_ERR_ARG;
-    if (!sph__check_phase(w, phase)) return SPH_ERR_ARG;
+    if (!sph__check_phase(w, "sph_fill_box", phase)) return SPH_ERR_ARG;
     s = sph__check_box(w, "sph_fill_box", lo, hi);
     if (s != SPH_OK) return s;
     mass = (double)w->phases[phase].mass;
@@ -2750,6 +2814,8 @@ SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, cons
     s = sph__append_fluid(w, phase, total, pts, NULL,
                           k == dim ? w->phases[phase].mass : (sph_real)mass, NULL, NULL);
     SPH_FREE(pts);
+    if (s == SPH_OK)
+        for (k = 0; k < 3; ++k) w->fill_spacing[k] = sp[k];
     return s;
 }
 
@@ -3047,7 +3113,8 @@ typedef struct sph__ctx {
     const sph_real *pr2c, *volc; /* p / rho^2 and m / rho per fluid particle for fast-path passes
                                   (sph__pair_cache; NULL: computed per pair)                    */
     int eos_walls;             /* wall density from the equation of state (WCSPH) or a Shepard
-                                  average of the fluid's (solvers without one, seed 000 sec. 3.2.3) */
+                                  average of the fluid's (solvers without one; Enhanced PCISPH
+                                  2018 sec. 3.2.3)                                               */
     sph_real alpha, beta, delta, visc_k;
     sph_real g[3];
     /* the compressible step */
@@ -3112,8 +3179,9 @@ static void sph__ctx_init(sph_world* w, sph__ctx* c) {
     c->av = w->def.alpha > 0 || w->def.beta > 0;
     c->delta = w->def.delta;
     c->delta_on = w->def.delta > 0;
-    /* Monaghan 2005 / seed 000 sec. 2.2.2: nu Lap v = 2(d+2) sum_j m_j nu_bar/rho_bar ...; with
-       (mu_i + mu_j)/(rho_i rho_j) the factor 2 of the average moves into visc_k = d + 2. */
+    /* Monaghan 2005 / Enhanced PCISPH 2018 sec. 2.2.2: nu Lap v = 2(d+2) sum_j m_j
+       nu_bar/rho_bar ...; with (mu_i + mu_j)/(rho_i rho_j) the factor 2 of the average moves into
+       visc_k = d + 2. */
     c->visc_k = (sph_real)(w->dim + 2);
     if (c->morris) c->visc_k = 1;
 }
@@ -3149,8 +3217,8 @@ SPH__INLINE void sph__delta_vec_p(const sph__ctx* c, const int per, const sph_re
    STATE (once per step): the sum b_sw = sum_f W_bf; for no-slip, Adami et al. 2012 eqs. 22-23:
        v~_b = 2 v_b - sum_f v_f W_bf / sum_f W_bf        (the velocity viscous terms see)
    and, for solvers without an equation of state, the wall density relative to rest as the
-   Shepard average of rho_f/rho0_f (seed 000 sec. 3.2.3's rho_w = sum_f rho_f W_bf / sum_f W_bf).
-   PRESSURE (with SPH_BP_EXTRAPOLATE), Adami et al. 2012, eq. 27:
+   Shepard average of rho_f/rho0_f (Enhanced PCISPH 2018 sec. 3.2.3's rho_w = sum_f rho_f W_bf /
+   sum_f W_bf). PRESSURE (with SPH_BP_EXTRAPOLATE), Adami et al. 2012, eq. 27:
        p_b = (sum_f p_f W_bf + sum_f rho_f (g_f - a_b) . x_bf W_bf) / sum_f W_bf, x_bf = x_b - x_f,
    with g_f the body acceleration of fluid particle f (gravity, the user's forces and, for the
    iterative solvers, viscosity: w->a holds it when this runs) and a_b the wall's acceleration; so
@@ -3451,7 +3519,7 @@ static size_t sph__count_within(const sph_grid* g, const sph_real* p, const sph_
 }
 #endif
 
-/* Akinci et al. 2012 (seed 003 eq. 27): a wall particle's volume is gamma_1 over its number
+/* Akinci et al. 2012 (Meiers 2025 eq. 27): a wall particle's volume is gamma_1 over its number
    density among wall particles, V_b = gamma_1 S / sum_b' W_bb' (b itself included; S the
    lattice sum, so a full lattice of wall particles keeps V_b = dx^dim), so sparse or single-layer
    walls weigh as much as a full lattice and dense clusters do not count twice. Recomputed
@@ -3539,11 +3607,11 @@ static sph_status sph__stage_neighbors(sph_world* w) {
     return SPH_OK;
 }
 
-/* Summation density (seed 000 eq. 2.4), walls as psi = rho0_i V_b (Akinci et al. 2012):
+/* Summation density (Enhanced PCISPH 2018 eq. 2.4), walls as psi = rho0_i V_b (Akinci et al. 2012):
        rho_i = (m_i W(0) + sum_f m_f W_if + sum_b rho0_i V_b W_ib) / S,
    S = the kernel's lattice sum (sph__lattice_sum): a particle lattice at spacing dx then has the
    rest density exactly, instead of 1 % more for Wendland C2 at h = 1.3 dx, which an incompressible
-   solver would remove by expanding the fluid (seed 003's reference code scales W the same way). */
+   solver would remove by expanding the fluid (Meiers 2025's reference code scales W the same way). */
 static void sph__stage_density_summation(sph_world* w, const sph__ctx* c) {
     const int D = c->dim;
     const sph_real w0 = c->k.norm_w * sph__kw(c->k.form, 0);
@@ -3610,24 +3678,25 @@ enum { SPH__PRESSURE = 1, SPH__VISCOUS = 2, SPH__RATE = 4, SPH__SET = 8, SPH__CA
 #define SPH__ACCEL (SPH__PRESSURE | SPH__VISCOUS)
 
 /* The one neighbour loop for accelerations and the density rate of fluid particle i.
-   PRESSURE: sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W_ij (seed 000 sec. 2.2.1), or the
-          multiphase form (p_i + p_j)/(rho_i rho_j) (Ott & Schnetter eq. 12); a wall particle is a
-          particle of mass psi_ib with the pressure and density of the chosen boundary scheme
+   PRESSURE: sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W_ij (Enhanced PCISPH 2018 sec. 2.2.1), or
+          the multiphase form (p_i + p_j)/(rho_i rho_j) (Ott & Schnetter eq. 12); a wall particle is
+          a particle of mass psi_ib with the pressure and density of the chosen boundary scheme
           (extrapolated; mirrored p_b = p_i, rho_b = rho_i; or p_b = 0). [m/s^2]
    VISCOUS: laminar viscosity (Morris et al. 1997: sum_j m_j (mu_i + mu_j)/(rho_i rho_j)
           x_ij.grad W_ij/(r^2+eta^2) v_ij, which needs only the second moment of grad W to give
           nu Lap v, 0.96 of it on a lattice with Wendland C2 at h = 1.3 dx; or Monaghan 2005 /
-          seed 000 eq. 2.5, 2(d+2) sum_j m_j nu_bar/rho_bar v_ij.x_ij/(r^2+eta^2) grad W, which
-          conserves angular momentum but needs the fourth moment: 0.80 of nu Lap v on the same
-          lattice) and Monaghan 1992 artificial viscosity Pi_ij = (-alpha c_bar mu_ij +
+          Enhanced PCISPH 2018 eq. 2.5, 2(d+2) sum_j m_j nu_bar/rho_bar v_ij.x_ij/(r^2+eta^2) grad
+          W, which conserves angular momentum but needs the fourth moment: 0.80 of nu Lap v on the
+          same lattice) and Monaghan 1992 artificial viscosity Pi_ij = (-alpha c_bar mu_ij +
           beta mu_ij^2)/rho_bar, mu_ij = h v_ij.x_ij/(r^2+eta^2) when v_ij.x_ij < 0, c_bar the
           mean of the phases' c0 (of the particles' own sound speeds in the compressible step).
           [m/s^2]
-   RATE:  continuity d rho_i/dt = sum_j m_j v_ij . grad W_ij (seed 000 eq. 2.2), or m_i in place
-          of m_j (Ott & Schnetter eq. 11), plus delta-SPH diffusion (Molteni & Colagrossi 2009,
-          seed 000 sec. 3.2.1) written with densities relative to each phase's rest density:
+   RATE:  continuity d rho_i/dt = sum_j m_j v_ij . grad W_ij (Enhanced PCISPH 2018 eq. 2.2), or
+          m_i in place of m_j (Ott & Schnetter eq. 11), plus delta-SPH diffusion (Molteni &
+          Colagrossi 2009; Enhanced PCISPH 2018 sec. 3.2.1) written with densities relative to
+          each phase's rest density:
           delta h c0 sum_j 2 rho0_i V_j (rho_i/rho0_i - rho_j/rho0_j) x_ij.grad W_ij/(r^2+eta^2),
-          which is seed 000's term for one phase and does not diffuse across a phase interface.
+          which is the thesis' term for one phase and does not diffuse across a phase interface.
           Walls enter with their own velocity (a moving wall compresses). [kg/m^3/s]
    ENERGY: every pairwise acceleration above is m_j f_ij with f_ij = -f_ji, so the work of the
           pair goes half to each side: de_i/dt = -1/2 sum_j m_j f_ij . v_ij, which for pressure
@@ -4309,7 +4378,7 @@ static void sph__pair_cache(sph_world* w, sph__ctx* c) {
     c->volc = w->priv.vol;
 }
 
-/* Symplectic Euler (seed 000 sec. 2.3, "semi-implicit"):
+/* Symplectic Euler (Enhanced PCISPH 2018 sec. 2.3, "semi-implicit"):
        v^{n+1}   = v^n + dt a(x^n, rho^n, v^n)
        rho^{n+1} = rho^n + dt R(x^n, v^{n+1})          R = density rate (continuity + delta-SPH)
        x^{n+1}   = x^n + dt v^{n+1}
@@ -4317,8 +4386,8 @@ static void sph__pair_cache(sph_world* w, sph__ctx* c) {
    integrated by forward Euler, which is unconditionally unstable (a tank at rest blows up within
    a few hundred steps). So a step is two neighbour passes over the same lists: forces, then the
    density rate.
-   Stormer-Verlet, drift-kick-drift (seed 000 sec. 2.3). Seed 000 leaves open how the density
-   joins the half steps (digest sec. 12 d). Decision: rho is a position-like variable advanced by
+   Stormer-Verlet, drift-kick-drift (Enhanced PCISPH 2018 sec. 2.3). The thesis leaves open how the
+   density joins the half steps. Decision: rho is a position-like variable advanced by
    the midpoint rule, R being linear in v:
        x^{n+1/2}   = x^n + dt/2 v^n
        rho~        = rho^n + dt/2 R_prev            (predictor, used only for the forces)
@@ -4419,14 +4488,14 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
 
 /* Adds the step's timings to the world's totals. */
 
-/* ---- the second-order scheme (seed 002, L-IPST-C) ---------------------------------------------
-   Negi & Ramachandran 2022 (seed 002 sec. II D 1, digest sec. 5.2), for periodic domains:
+/* ---- the second-order scheme (L-IPST-C) --------------------------------------------------------
+   Negi & Ramachandran 2022 (sec. II D 1), for periodic domains:
        d rho_i/dt = -rho_i <div u>_i                         div_bc (Table II)
        d u_i/dt   = -<grad p>_i / rho_i + nu <Lap u>_i + g    asym_bc, coupled_bc
    with rho the fluid density carried by the particle (w->rho) and p = p(rho) by the phase's
    equation of state; the operators' volumes are the Shepard volumes omega = 1/sum_j W_ij of the
    geometry, never m/rho (sec. III A: the EOS must not see the particle density). Decisions where
-   the paper is silent (digest sec. 10): RK2 is the midpoint rule (y* = y + dt/2 f(y), then
+   the paper is silent: RK2 is the midpoint rule (y* = y + dt/2 f(y), then
    y += dt f(y*)), the midpoint with its own neighbour lists; shifting (eq. 19-21) runs after
    every def.shift_every-th step, at most 10 iterations, until max_i |chi_i - chi_0| < 1e-3 chi_0
    with chi = h^d sum_j W_ij (chi_0 its lattice value; the paper leaves epsilon open), and each
@@ -4440,7 +4509,7 @@ static sph_status sph__soc_check(sph_world* w) {
         if (!w->def.periodic[k])
             return sph__fail(w, SPH_ERR_ARG, -1,
                              "def.scheme = SPH_SCHEME_SECOND_ORDER needs every direction periodic "
-                             "(direction %d is not): seed 002 has no second-order wall condition", k);
+                             "(direction %d is not): the scheme has no wall condition", k);
     if (w->nb > 0)
         return sph__fail(w, SPH_ERR_ARG, -1,
                          "def.scheme = SPH_SCHEME_SECOND_ORDER runs without walls (%zu boundary "
@@ -4862,32 +4931,33 @@ SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt) {
 /* ============================================================================================== */
 /* >>pcisph (implementation)                                                                      */
 /* ============================================================================================== */
-/* Predictive-corrective incompressible SPH (Solenthaler & Pajarola 2009; seed 000 Alg. 5 and
-   sec. 3.2). Each step, after the non-pressure accelerations a_np:
+/* Predictive-corrective incompressible SPH (Solenthaler & Pajarola 2009; Enhanced PCISPH 2018
+   Alg. 5 and sec. 3.2). Each step, after the non-pressure accelerations a_np:
      p = warm_start * p^{n-1} (Alg. 5: 0), a_p = 0;  repeat:
        v* = v^n + dt (a_np + a_p)
        rho* = summation over predicted positions x* = x + dt v*           (original)
-            | rho^n + dt [sum_j m_j (v*_i - v*_j).grad W_ij + delta-SPH]   (enhanced, seed 000
+            | rho^n + dt [sum_j m_j (v*_i - v*_j).grad W_ij + delta-SPH]   (enhanced, thesis
               sec. 3.2.1 and 3.2.4; Ott-Schnetter's m_i with SPH_DENSITY_PARTICLE)
        p_i = max(0, p_i + f_i (rho*_i - rho0_i))      negative pressure is clamped (free surfaces)
-       [p_i = chi p_i + (1 - chi) <p>_i]              pressure smoothing, seed 000 sec. 3.2.1
+       [p_i = chi p_i + (1 - chi) <p>_i]              pressure smoothing, thesis sec. 3.2.1
        a_p = pressure acceleration of p (at x* with summation density, at x^n otherwise)
      until the mean compression max(rho* / rho0 - 1, 0) <= tolerance (and the largest <= tolerance_max
      if set), after min_iterations and at most max_iterations; then v^{n+1} = v^n + dt (a_np + a_p)
      with the last a_p, x^{n+1} = x^n + dt v^{n+1}, and with continuity rho^{n+1} = rho^n + dt R(v^{n+1}).
-   The gain f (seed 000 eq. 3.5 and sec. 3.2.4; the factor 2 of digest sec. 5.2 is pcisph_gain):
+   The gain f (Enhanced PCISPH 2018 eq. 3.5 and sec. 3.2.4; Solenthaler & Pajarola 2009 move a
+   particle by dt^2 F/m where the thesis has dt^2/2 F/m, which doubles its gain: pcisph_gain):
      prototype    f = gain rho0^2 / (2 dt^2 m^2 sum_j |grad W_0j|^2), a full lattice neighbourhood
                   (where sum_j grad W_0j = 0), per phase;
      per particle f_i = gain rho_i / (2 dt^2 [(sum_j V_j gW_ij).(sum_j m_j gW_ij) + m_i sum_j V_j |gW_ij|^2])
                   from the actual neighbours and masses at x^n (walls in the first product), per step.
    With summation density the predicted density is divided by the lattice sum S, so f is too.
-   Decisions where seed 000 is silent (digest sec. 12):
+   Decisions where the thesis is silent:
      (b) diffusion and smoothing act inside the loop: delta-SPH is part of every predicted
          density (it must be, or the correction would undo it), and the accumulated pressure is
          smoothed after each correction (Shepard-normalised, so free surfaces and walls are not
          biased low), i.e. the iteration converges to a smooth pressure;
      (c) wall pressure is extrapolated from the current pressure in every iteration, the wall
-         density is the Shepard average of the fluid's (seed 000 sec. 3.2.3);
+         density is the Shepard average of the fluid's (thesis sec. 3.2.3);
      (e) Alg. 5 starts every step from p = 0: one step of gravity barely compresses the predicted
          state, so the loop stops with a fraction of the hydrostatic pressure and the fluid sags
          until a standing compression near the tolerance carries it (an underdamped, WCSPH-like
@@ -4912,11 +4982,11 @@ static double sph__lattice_grad2(const sph_kernel* k, sph_real dx) {
     return sum;
 }
 
-/* Denominator of the per-particle gain at x^n (without dt^2), seed 000 sec. 3.2.4:
+/* Denominator of the per-particle gain at x^n (without dt^2), Enhanced PCISPH 2018 sec. 3.2.4:
        (sum_j V_j gW_ij) . (sum_j mu_j gW_ij) + m_i sum_j (mu_j / rho_j) |gW_ij|^2,
    where mu_j is the mass that weighs neighbour j in the density change: m_j for the continuity
-   equation (seed 000's derivation), m_i for Ott-Schnetter's particle density, for which the
-   seed-000 gain would be several times too large for a heavy particle among light ones (the
+   equation (the thesis' derivation), m_i for Ott-Schnetter's particle density, for which the
+   thesis' gain would be several times too large for a heavy particle among light ones (the
    corrector then oscillates across a 5:1 interface). */
 SPH__INLINE sph_real sph__pcisph_denominator(const sph__ctx* c, size_t i, const int D) {
     const sph_real* xi = c->x + i * (size_t)D;
@@ -5024,9 +5094,9 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
         return s;
     }
     sph__ctx_init(w, &c);
-    /* delta-SPH needs a speed of sound, which PCISPH does not have (seed 000 sec. 3.2.1 leaves it
-       open). The phase's c0 would make the explicit diffusion unstable at PCISPH's large steps
-       (delta h c0 dt / h^2 grows with dt); c = cfl h / dt is the speed for which dt is the
+    /* delta-SPH needs a speed of sound, which PCISPH does not have (Enhanced PCISPH 2018 sec. 3.2.1
+       leaves it open). The phase's c0 would make the explicit diffusion unstable at PCISPH's large
+       steps (delta h c0 dt / h^2 grows with dt); c = cfl h / dt is the speed for which dt is the
        acoustic CFL step, so the term has per step the strength it has in WCSPH. */
     c.delta_c = w->def.cfl * w->h / dt;
     sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
@@ -5161,8 +5231,8 @@ SPHDEF sph_status sph_step_pcisph(sph_world* w, sph_real dt) {
 /* ============================================================================================== */
 /* >>iisph (implementation)                                                                       */
 /* ============================================================================================== */
-/* Implicit incompressible SPH, Ihmsen et al. 2014 in the form of Koschier et al. 2020 and seed 003
-   (Alg. 1-2), with the thesis' errata and the reference code's bugs fixed (digest sec. 6, 8):
+/* Implicit incompressible SPH, Ihmsen et al. 2014 in the form of Koschier et al. 2020 and Meiers
+   2025 (Alg. 1-2), with the thesis' errata and the reference code's bugs fixed:
      rho_i   summation density at x^n (walls as psi = rho0_i V_b; all density sums below are
              divided by the kernel's lattice sum S, as the summation density is);
      v*      = v^n + dt a_np, a_np = gravity + user forces + viscosity;
@@ -5177,7 +5247,8 @@ SPHDEF sph_status sph_step_pcisph(sph_world* w, sph_real dt) {
              after min_iterations and at most max_iterations;
      move    v = v* + dt a^p(p_final), x += dt v: the last update is applied (the thesis'
              algorithm moves with the pressure before the last update).
-   The diagonal is exact for the operator above (digest sec. 2.3 generalised to unequal masses):
+   The diagonal is exact for the operator above (Meiers 2025 eq. 22 and 26, made exact
+   and generalised to unequal masses):
      a_ii = dt^2 [ -(sum_j m_j gW_ij + sum_b psi_ib (1 + k_b rho_i^2/rho_b^2) gW_ib)
                     . (sum_j m_j gW_ij + sum_b psi_ib gW_ib) / rho_i^2 - m_i/rho_i^2 sum_j m_j |gW_ij|^2 ]
    with k_b = d p_b / d p_i: 0 for zero pressure, 1 for mirroring, W_bi / sum_f W_bf for
@@ -5411,7 +5482,7 @@ SPHDEF sph_status sph_step_iisph(sph_world* w, sph_real dt) {
 /* ============================================================================================== */
 /* >>compressible (implementation)                                                                */
 /* ============================================================================================== */
-/* Explicit compressible multiphase SPH (Ott & Schnetter 2003, seed 004). Symplectic Euler as in
+/* Explicit compressible multiphase SPH (Ott & Schnetter 2003). Symplectic Euler as in
    the WCSPH step, with an internal energy that conserves the total energy:
        a^n       = g + a(x^n, rho^n, e^n, v^n)                 eq. 12 + artificial viscosity
        v^{n+1}   = v^n + dt a^n
@@ -5424,7 +5495,7 @@ SPHDEF sph_status sph_step_iisph(sph_world* w, sph_real dt) {
    round-off by any dt (tests/test_compressible.c). The density takes the new velocity (stable
    acoustics, see >>wcsph); the energy's mean velocity differs from it by dt a/2, an O(dt)
    entropy error per unit time in smooth flow (the sound-pulse test bounds its effect).
-   Decisions where seed 004 is silent: its artificial viscosity is Monaghan's (1992) with the
+   Decisions where the paper is silent: its artificial viscosity is Monaghan's (1992) with the
    particles' own sound speeds in c_bar and beta left to def.beta (its shock tube needs only alpha);
    walls are Adami walls whose density follows each phase's isentrope through its rest state;
    phases with the Tait or linear law keep them and their energy is evolved but unused. Two
@@ -5534,7 +5605,7 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
             if (sp > smax) smax = sp;
         }
         if (smax > 0) dt = (double)w->def.cfl * (double)w->h / smax;
-    } else if (v2max > 0) { /* seed 003 eq. 14: a particle moves at most cfl_velocity dx per step */
+    } else if (v2max > 0) { /* Meiers 2025 eq. 14: a particle moves at most cfl_velocity dx per step */
         dt = (double)w->def.cfl_velocity * (double)w->dx / sqrt(v2max);
     }
     /* The explicit viscous step is stable while dt nu lambda_max <= 2. A Fourier analysis of the

@@ -13,7 +13,7 @@
      growth      time per step against N (10^3 .. 10^6 in 2D) per solver; fitted exponent
      model       the 2D dam break with one optional piece of physics on at a time: bytes, time
      run         one measurement: --scene, --n, --solver, --threads, --repeats, --steps
-     iisph-sweep seed 003's Table 2 for our IISPH (time step against iterations and cost)
+     iisph-sweep Meiers 2025's Table 2 for our IISPH (time step against iterations and cost)
    Options: --quick (small sizes, < 1 minute), --out DIR (CSV and SVG; default bench/results),
             --n N, --scene S, --solver S, --threads T, --repeats R, --steps K
    Every timing is the median over the repeats of a wall-clock time per step; runs that are
@@ -490,7 +490,7 @@ static int suite_run(const opts* o) {
     return 1;
 }
 
-/* Seed 003's Table 2 for our solver: the time step against iterations and time to solution. */
+/* Meiers 2025's Table 2 for our solver: the time step against iterations and time to solution. */
 static int suite_iisph_sweep(const opts* o) {
     static const double fs[] = {0.005, 0.0075, 0.01, 0.015, 0.02, 0.03, 0.05, 0.08};
     const int res = o->quick ? 20 : 40;

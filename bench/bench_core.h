@@ -59,7 +59,7 @@ BENCH_FN uint64_t BX(hash)(const sph_world* w) {
 }
 
 /* The time step of a timed run. WCSPH: sph_stable_dt (acoustic CFL). The incompressible solvers'
-   limit is seed 003 eq. 14, cfl_velocity dx / |v|max, and |v|max is 0 at the start, so they get
+   limit is Meiers 2025 eq. 14, cfl_velocity dx / |v|max, and |v|max is 0 at the start, so they get
    it with the speed the flow will reach, U = c0 / 10 (the automatic sound speed is 10 U with
    U = sqrt(2 |g| H), sph.h's rule): one fixed step for the whole run, as a user would pick. */
 BENCH_FN double BX(bench_dt)(sph_world* w, int solver) {

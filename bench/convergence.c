@@ -1,12 +1,13 @@
-/* bench/convergence.c - seed 002's Taylor-Green convergence study (Re = 100, unit periodic box,
-   t = 0.5 s): L1 errors of |u| and p against the exact solution for the second-order scheme
-   (def.scheme = SPH_SCHEME_SECOND_ORDER, L-IPST-C) at c0 = 20, 40, 80 m/s and for the plain WCSPH
-   step at c0 = 20 and 80, over N^2 particles, N = 20, 28, 40, 56, 80 (a factor sqrt 2 apart; up
-   to the first argument, at most 160), with the order fitted by least squares. dt = 0.3 h / (U + c0) per resolution (seed 002 fixes it by the
-   finest resolution; with RK2 the time error is second order too). Quintic spline, h = 1.2 dx.
+/* bench/convergence.c - Negi & Ramachandran 2022's Taylor-Green convergence study (Re = 100, unit
+   periodic box, t = 0.5 s): L1 errors of |u| and p against the exact solution for the second-order
+   scheme (def.scheme = SPH_SCHEME_SECOND_ORDER, L-IPST-C) at c0 = 20, 40, 80 m/s and for the plain
+   WCSPH step at c0 = 20 and 80, over N^2 particles, N = 20, 28, 40, 56, 80 (a factor sqrt 2 apart;
+   up to the first argument, at most 160), with the order fitted by least squares.
+   dt = 0.3 h / (U + c0) per resolution (the paper fixes it by the finest resolution; with RK2 the
+   time error is second order too). Quintic spline, h = 1.2 dx.
    Build: cc -O2 -fopenmp -I. bench/convergence.c -o convergence -lm
    Run:   ./convergence [max N = 80] [output directory = bench/results]
-   (about 20 minutes on 2 cores at the default; seed 002 went to 500^2)
+   (about 20 minutes on 2 cores at the default; the paper went to 500^2)
    Writes taylor_green.csv, taylor_green_u.svg, taylor_green_p.svg. */
 #define SPH_IMPLEMENTATION
 #include "sph.h"

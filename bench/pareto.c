@@ -4,7 +4,7 @@
    stability maps (the largest stable time-step factor per solver and scene, the density-ratio
    limit per density formulation).
 
-   Scenes and metrics (reference data: validation-data.md):
+   Scenes and metrics (reference data from the works named):
      dam break    Martin & Moyce 1952 (scene_dam_break, a = 0.1 m): RMS over the table's points
                   with T <= 3 of (Z_sph - Z) / Z, Z = front / a at T = t sqrt(2 g / a).
      hydrostatic  Adami, Hu & Adams 2012 sec. 6 (scene_hydrostatic, 1 m wide, H = 0.5 m deep):

@@ -6,7 +6,7 @@
 #define SPH_IMPLEMENTATION
 #include "sph.h"
 #include "examples/scenes.h"
-#include "examples/image.h"
+#include "examples/draw.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,33 +23,14 @@ static double mm_front(double T) {
 }
 
 /* Particles as discs in a 1000 px wide picture of the tank and its walls; fluid coloured by
-   speed relative to sqrt(2 g 2a), the free-fall speed from the column's top. */
+   speed from 0 to sqrt(2 g 2a), the free-fall speed from the column's top. */
 static void render(const sph_world* w, const scene_dam* d, const char* path, const char* label) {
-    const double margin = 4 * (double)w->dx, wx = d->length + 2 * margin, wy = d->height + 2 * margin;
-    const int W = 1000, H = (int)(W * wy / wx + 0.5);
-    const double scale = W / wx, umax = sqrt(2 * 9.81 * 2 * d->a);
-    const double rad = 0.62 * (double)w->dx * scale;
-    img im;
-    size_t i;
-    if (!img_init(&im, W, H + 28)) return;
-    img_fill(&im, 250, 250, 248);
-    for (i = 0; i < w->nb; ++i) {
-        const sph_real* x = w->b_x + i * 2;
-        img_disc(&im, ((double)x[0] + margin) * scale, H - ((double)x[1] + margin) * scale, rad, 140,
-                 140, 140);
-    }
-    for (i = 0; i < w->n; ++i) {
-        const sph_real* x = w->x + i * 2;
-        const double s = sqrt((double)(w->v[2 * i] * w->v[2 * i] + w->v[2 * i + 1] * w->v[2 * i + 1]));
-        unsigned char c[3];
-        img_colormap(s / umax, c);
-        img_disc(&im, ((double)x[0] + margin) * scale, H - ((double)x[1] + margin) * scale, rad, c[0],
-                 c[1], c[2]);
-    }
-    img_rect(&im, 0, H, W, H + 28, 255, 255, 255);
-    img_text(&im, 8, H + 6, 2, label, 30, 30, 30);
-    if (img_write_png(&im, path) != 0) fprintf(stderr, "could not write %s\n", path);
-    img_free(&im);
+    const double margin = 4 * (double)w->dx;
+    draw pic;
+    if (!draw_begin(&pic, w, -margin, -margin, d->length + margin, d->height + margin, 1000)) return;
+    draw_walls(&pic, w, -1, 140, 140, 140);
+    draw_fluid_speed(&pic, w, sqrt(2 * 9.81 * 2 * d->a));
+    draw_finish(&pic, path, label);
 }
 
 int main(int argc, char** argv) {
@@ -72,10 +53,8 @@ int main(int argc, char** argv) {
         fprintf(stderr, "scene: %s\n", scene_error);
         return 1;
     }
-    snprintf(path, sizeof(path), "%s/dambreak_front.csv", dir);
-    csv = fopen(path, "w");
+    csv = draw_fopen(dir, "dambreak_front.csv");
     if (!csv) {
-        fprintf(stderr, "cannot write to %s/ (create the directory first)\n", dir);
         sph_world_free(&w);
         return 1;
     }
@@ -95,7 +74,7 @@ int main(int argc, char** argv) {
             sq += (Z - Zmm) * (Z - Zmm) / (Zmm * Zmm);
             ++nmm;
         }
-        snprintf(path, sizeof(path), "%s/dambreak_%04d.png", dir, frame);
+        draw_frame_path(path, sizeof(path), dir, "dambreak", frame);
         render(&w, &d, path, label);
         fprintf(csv, "%.5f,%.4f,%.4f,%s\n", w.time, T, Z, Zmm > 0 ? mm : "");
         printf("%5d %7.3f %6.2f %7.3f %7s %8llu %8.3f %9.5f\n", frame, w.time, T, Z, mm,

@@ -20,7 +20,7 @@
    example uses h = 2 dx, where it is about 1.5 % high. */
 #define SPH_IMPLEMENTATION
 #include "sph.h"
-#include "examples/image.h"
+#include "examples/draw.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -81,46 +81,44 @@ static void render(const sph_world* w, const channel* c, double L, const char* p
     const double rad = 0.55 * (double)w->dx * scale, y0 = margin + 4 * (double)w->dx * scale;
     double u[256];
     int cnt[256], rows, r, k;
-    img im;
+    draw pic;
+    img* im = &pic.im;
     size_t i;
-    if (!img_init(&im, W, (int)(2 * y0) + PH + 28)) return;
-    img_fill(&im, 250, 250, 248);
+    if (!draw_canvas(&pic, W, (int)(2 * y0) + PH)) return;
     for (i = 0; i < w->nb; ++i)
-        img_disc(&im, margin + (double)w->b_x[2 * i] * scale, y0 + PH - (double)w->b_x[2 * i + 1] * scale,
+        img_disc(im, margin + (double)w->b_x[2 * i] * scale, y0 + PH - (double)w->b_x[2 * i + 1] * scale,
                  rad, 140, 140, 140);
     for (i = 0; i < w->n; ++i) {
         unsigned char col[3];
         img_colormap((double)w->v[2 * i] / (1.2 * umax), col);
-        img_disc(&im, margin + (double)w->x[2 * i] * scale, y0 + PH - (double)w->x[2 * i + 1] * scale,
+        img_disc(im, margin + (double)w->x[2 * i] * scale, y0 + PH - (double)w->x[2 * i + 1] * scale,
                  rad, col[0], col[1], col[2]);
     }
     /* plot frame: u from 0 to 1.2 u_max across plot_w pixels, y as in the picture of the cell */
-    img_rect(&im, px0, (int)y0, px0 + 1, (int)y0 + PH, 60, 60, 60);
-    img_rect(&im, px0, (int)y0 + PH, px0 + plot_w, (int)y0 + PH + 1, 60, 60, 60);
-    img_rect(&im, px0, (int)y0, px0 + plot_w, (int)y0 + 1, 60, 60, 60);
-    img_rect(&im, px0 + (int)(plot_w / 1.2), (int)y0, px0 + (int)(plot_w / 1.2) + 1, (int)y0 + PH,
+    img_rect(im, px0, (int)y0, px0 + 1, (int)y0 + PH, 60, 60, 60);
+    img_rect(im, px0, (int)y0 + PH, px0 + plot_w, (int)y0 + PH + 1, 60, 60, 60);
+    img_rect(im, px0, (int)y0, px0 + plot_w, (int)y0 + 1, 60, 60, 60);
+    img_rect(im, px0 + (int)(plot_w / 1.2), (int)y0, px0 + (int)(plot_w / 1.2) + 1, (int)y0 + PH,
              200, 200, 200); /* u = u_max */
     for (k = 0; k <= PH; ++k) {
         const double y = c->H * k / PH;
         const double us = c->gx * y * (c->H - y) / (2 * c->nu), ue = exact_u(c, y, w->time);
-        img_disc(&im, px0 + us / (1.2 * umax) * plot_w, y0 + PH - k, 1.2, 170, 170, 170);
-        img_disc(&im, px0 + ue / (1.2 * umax) * plot_w, y0 + PH - k, 1.2, 20, 20, 20);
+        img_disc(im, px0 + us / (1.2 * umax) * plot_w, y0 + PH - k, 1.2, 170, 170, 170);
+        img_disc(im, px0 + ue / (1.2 * umax) * plot_w, y0 + PH - k, 1.2, 20, 20, 20);
     }
     rows = row_means(w, c->H, u, cnt, 256);
     for (r = 0; r < rows; ++r) {
         unsigned char col[3];
         if (!cnt[r]) continue;
         img_colormap(u[r] / (1.2 * umax), col);
-        img_disc(&im, px0 + u[r] / (1.2 * umax) * plot_w, y0 + PH - (r + 0.5) * (double)w->dx * scale,
+        img_disc(im, px0 + u[r] / (1.2 * umax) * plot_w, y0 + PH - (r + 0.5) * (double)w->dx * scale,
                  4.5, col[0], col[1], col[2]);
     }
-    img_text(&im, px0, 4, 1, "u(y): rows of particles (dots), exact (black),\nsteady parabola (grey)",
+    img_text(im, px0, 4, 1, "u(y): rows of particles (dots), exact (black),\nsteady parabola (grey)",
              30, 30, 30);
-    img_text(&im, px0 + (int)(plot_w / 1.2) - 20, (int)y0 + PH + 4, 1, "u_max", 30, 30, 30);
-    img_rect(&im, 0, (int)(2 * y0) + PH, W, (int)(2 * y0) + PH + 28, 255, 255, 255);
-    img_text(&im, 8, (int)(2 * y0) + PH + 6, 2, label, 30, 30, 30);
-    if (img_write_png(&im, path) != 0) fprintf(stderr, "could not write %s\n", path);
-    img_free(&im);
+    img_text(im, px0 + (int)(plot_w / 1.2) - 20, (int)y0 + PH + 4, 1, "u_max", 30, 30, 30);
+    draw_colorbar(&pic, "u [mm/s]", 0, 1.2e3 * umax); /* the colours above: u / (1.2 u_max) */
+    draw_finish(&pic, path, label);
 }
 
 int main(int argc, char** argv) {
@@ -166,10 +164,8 @@ int main(int argc, char** argv) {
         sph_world_free(&w);
         return 1;
     }
-    snprintf(path, sizeof(path), "%s/external_force_profile.csv", dir);
-    csv = fopen(path, "w");
+    csv = draw_fopen(dir, "external_force_profile.csv");
     if (!csv) {
-        fprintf(stderr, "cannot write to %s/ (create the directory first)\n", dir);
         sph_world_free(&w);
         return 1;
     }
@@ -185,7 +181,7 @@ int main(int argc, char** argv) {
         ucen_exact = exact_u(&ch, 0.5 * ch.H, w.time);
         snprintf(label, sizeof(label), "t = %.2f s  centre u = %.2f mm/s  exact %.2f mm/s", w.time,
                  1e3 * ucen, 1e3 * ucen_exact);
-        snprintf(path, sizeof(path), "%s/external_force_%04d.png", dir, frame);
+        draw_frame_path(path, sizeof(path), dir, "external_force", frame);
         render(&w, &ch, L, path, label);
         printf("%5d %6.2f %12.6f %12.6f %7llu %8.3f\n", frame, w.time, ucen, ucen_exact,
                (unsigned long long)w.steps, w.steps ? 1e3 * w.step_time_total / (double)w.steps : 0.0);

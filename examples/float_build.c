@@ -25,36 +25,21 @@
 #define SPH_IMPLEMENTATION
 #include "sph.h"
 #include "examples/scenes.h"
-#include "examples/image.h"
+#include "examples/draw.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
-/* Particles as discs in a 1000 px wide picture of the tank; fluid coloured by speed relative to
+/* Particles as discs in a 1000 px wide picture of the tank; fluid coloured by speed from 0 to
    sqrt(2 g 2a), the free-fall speed from the column's top. */
 static void render(const sph_world* w, const scene_dam* d, const char* path, const char* label) {
-    const double margin = 4 * (double)w->dx, wx = d->length + 2 * margin, wy = d->height + 2 * margin;
-    const int W = 1000, H = (int)(W * wy / wx + 0.5);
-    const double scale = W / wx, umax = sqrt(2 * 9.81 * 2 * d->a), rad = 0.62 * (double)w->dx * scale;
-    img im;
-    size_t i;
-    if (!img_init(&im, W, H + 28)) return;
-    img_fill(&im, 250, 250, 248);
-    for (i = 0; i < w->nb; ++i)
-        img_disc(&im, ((double)w->b_x[2 * i] + margin) * scale,
-                 H - ((double)w->b_x[2 * i + 1] + margin) * scale, rad, 140, 140, 140);
-    for (i = 0; i < w->n; ++i) {
-        const double vx = (double)w->v[2 * i], vy = (double)w->v[2 * i + 1];
-        unsigned char c[3];
-        img_colormap(sqrt(vx * vx + vy * vy) / umax, c);
-        img_disc(&im, ((double)w->x[2 * i] + margin) * scale, H - ((double)w->x[2 * i + 1] + margin) * scale,
-                 rad, c[0], c[1], c[2]);
-    }
-    img_rect(&im, 0, H, W, H + 28, 255, 255, 255);
-    img_text(&im, 8, H + 6, 2, label, 30, 30, 30);
-    if (img_write_png(&im, path) != 0) fprintf(stderr, "could not write %s\n", path);
-    img_free(&im);
+    const double margin = 4 * (double)w->dx;
+    draw pic;
+    if (!draw_begin(&pic, w, -margin, -margin, d->length + margin, d->height + margin, 1000)) return;
+    draw_walls(&pic, w, -1, 140, 140, 140);
+    draw_fluid_speed(&pic, w, sqrt(2 * 9.81 * 2 * d->a));
+    draw_finish(&pic, path, label);
 }
 
 /* Particles that are not finite or whose centre lies beyond the walls' first layer. */
@@ -88,10 +73,8 @@ int main(int argc, char** argv) {
         fprintf(stderr, "scene: %s\n", scene_error);
         return 1;
     }
-    snprintf(path, sizeof(path), "%s/float_build_front.csv", dir);
-    csv = fopen(path, "w");
+    csv = draw_fopen(dir, "float_build_front.csv");
     if (!csv) {
-        fprintf(stderr, "cannot write to %s/ (create the directory first)\n", dir);
         sph_world_free(&w);
         return 1;
     }
@@ -118,7 +101,7 @@ int main(int argc, char** argv) {
         fprintf(csv, "%.5f,%.3f,%.4f,%.3f\n", w.time, scene_mm_T[k], Z, scene_mm_Z[k]);
         snprintf(label, sizeof(label), "float   t = %.3f s   T = %.2f   front Z = %.2f   Martin & Moyce %.2f",
                  w.time, scene_mm_T[k], Z, scene_mm_Z[k]);
-        snprintf(path, sizeof(path), "%s/float_build_%04d.png", dir, k);
+        draw_frame_path(path, sizeof(path), dir, "float_build", k);
         render(&w, &d, path, label);
         printf("%5d %7.3f %6.2f %7.3f %7.3f %8llu %8.3f\n", k, w.time, scene_mm_T[k], Z, scene_mm_Z[k],
                (unsigned long long)w.steps, 1e3 * w.step_time_total / (double)w.steps);

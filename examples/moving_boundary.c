@@ -19,7 +19,7 @@
    could have got there. */
 #define SPH_IMPLEMENTATION
 #include "sph.h"
-#include "examples/image.h"
+#include "examples/draw.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -103,35 +103,17 @@ static size_t count_escaped(const sph_world* w, double L, double x_paddle) {
     return out;
 }
 
-/* Particles as discs in a 1000 px wide picture of the tank; fluid coloured by speed (0 .. umax). */
+/* Particles as discs in a 1000 px wide picture of the tank; fluid coloured by speed (0 .. umax),
+   walls grey, the paddle orange. */
 static void render(const sph_world* w, const double* view, double umax, const char* path,
                    const char* label) {
-    const double wx = view[2] - view[0], wy = view[3] - view[1];
-    const int W = 1000, H = (int)(W * wy / wx + 0.5);
-    const double scale = W / wx, rad = 0.62 * (double)w->dx * scale;
-    img im;
-    size_t i;
-    if (!img_init(&im, W, H + 28)) return;
-    img_fill(&im, 250, 250, 248);
-    for (i = 0; i < w->nb; ++i) {
-        const double px = ((double)w->b_x[2 * i] - view[0]) * scale;
-        const double py = H - ((double)w->b_x[2 * i + 1] - view[1]) * scale;
-        if (w->b_body[i] == PADDLE)
-            img_disc(&im, px, py, rad, 230, 120, 30);
-        else
-            img_disc(&im, px, py, rad, 140, 140, 140);
-    }
-    for (i = 0; i < w->n; ++i) {
-        const double vx = (double)w->v[2 * i], vy = (double)w->v[2 * i + 1];
-        unsigned char c[3];
-        img_colormap(sqrt(vx * vx + vy * vy) / umax, c);
-        img_disc(&im, ((double)w->x[2 * i] - view[0]) * scale,
-                 H - ((double)w->x[2 * i + 1] - view[1]) * scale, rad, c[0], c[1], c[2]);
-    }
-    img_rect(&im, 0, H, W, H + 28, 255, 255, 255);
-    img_text(&im, 8, H + 6, 2, label, 30, 30, 30);
-    if (img_write_png(&im, path) != 0) fprintf(stderr, "could not write %s\n", path);
-    img_free(&im);
+    draw pic;
+    if (!draw_begin(&pic, w, view[0], view[1], view[2], view[3], 1000)) return;
+    draw_walls(&pic, w, -1, 140, 140, 140);
+    draw_walls(&pic, w, PADDLE, 230, 120, 30);
+    draw_fluid_speed(&pic, w, umax);
+    draw_swatch(&pic, "paddle", 230, 120, 30);
+    draw_finish(&pic, path, label);
 }
 
 int main(int argc, char** argv) {
@@ -199,10 +181,8 @@ int main(int argc, char** argv) {
     }
     free(px);
 
-    snprintf(path, sizeof(path), "%s/moving_boundary_level.csv", dir);
-    csv = fopen(path, "w");
+    csv = draw_fopen(dir, "moving_boundary_level.csv");
     if (!csv) {
-        fprintf(stderr, "cannot write to %s/ (create the directory first)\n", dir);
         sph_world_free(&w);
         return 1;
     }
@@ -225,7 +205,7 @@ int main(int argc, char** argv) {
         if (sample % frame_every == 0) {
             snprintf(label, sizeof(label), "t = %.1f s   paddle x = %+.3f m   far wall level %+.3f m",
                      w.time, x_p, level - level0);
-            snprintf(path, sizeof(path), "%s/moving_boundary_%04d.png", dir, frame++);
+            draw_frame_path(path, sizeof(path), dir, "moving_boundary", frame++);
             render(&w, view, umax, path, label);
             printf("%5d %6.2f %+9.3f %+12.4f %9.3f %7llu %8.3f\n", frame - 1, w.time, x_p,
                    level - level0, w.stats.v_max, (unsigned long long)w.steps,

@@ -1,6 +1,6 @@
 /* multiphase.c - two fluids: the Rayleigh-Taylor instability, a heavy fluid (density 1.8) over a
    light one (1.0) in a closed 1 x 2 box under gravity g = 1, with a wavy interface, Re = 420
-   (scene_rayleigh_taylor in examples/scenes.h; seed 000 sec. 5.4). WCSPH.
+   (scene_rayleigh_taylor in examples/scenes.h; Enhanced PCISPH 2018 sec. 5.4). WCSPH.
 
    Two phases are two sph_world_add_phase calls; each particle carries its phase (w.phase[i]) and,
    since the two rest densities differ at equal spacing, its own mass (w.m[i]). Across a density
@@ -22,7 +22,7 @@
 #define SPH_IMPLEMENTATION
 #include "sph.h"
 #include "examples/scenes.h"
-#include "examples/image.h"
+#include "examples/draw.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -71,28 +71,19 @@ static size_t count_escaped(const sph_world* w) {
 
 /* Particles as discs in a 400 x 800 px picture of the box, coloured by phase. */
 static void render(const sph_world* w, const char* path, const char* label) {
-    const double margin = 4 * (double)w->dx, scale = 400 / (1 + 2 * margin);
-    const int W = 400, H = (int)((2 + 2 * margin) * scale + 0.5);
-    const double rad = 0.62 * (double)w->dx * scale;
-    img im;
+    const double margin = 4 * (double)w->dx;
+    draw pic;
     size_t i;
-    if (!img_init(&im, W, H + 28)) return;
-    img_fill(&im, 250, 250, 248);
-    for (i = 0; i < w->nb; ++i)
-        img_disc(&im, ((double)w->b_x[2 * i] + margin) * scale,
-                 H - ((double)w->b_x[2 * i + 1] + margin) * scale, rad, 140, 140, 140);
+    if (!draw_begin(&pic, w, -margin, -margin, 1 + margin, 2 + margin, 400)) return;
+    draw_walls(&pic, w, -1, 140, 140, 140);
     for (i = 0; i < w->n; ++i) {
-        const double px = ((double)w->x[2 * i] + margin) * scale;
-        const double py = H - ((double)w->x[2 * i + 1] + margin) * scale;
-        if (w->phase[i] == HEAVY)
-            img_disc(&im, px, py, rad, 225, 110, 40);
-        else
-            img_disc(&im, px, py, rad, 60, 120, 210);
+        const int heavy = w->phase[i] == HEAVY;
+        draw_disc(&pic, (double)w->x[2 * i], (double)w->x[2 * i + 1], heavy ? 225 : 60,
+                  heavy ? 110 : 120, heavy ? 40 : 210);
     }
-    img_rect(&im, 0, H, W, H + 28, 255, 255, 255);
-    img_text(&im, 8, H + 6, 2, label, 30, 30, 30);
-    if (img_write_png(&im, path) != 0) fprintf(stderr, "could not write %s\n", path);
-    img_free(&im);
+    draw_swatch(&pic, "heavy, rho 1.8", 225, 110, 40);
+    draw_swatch(&pic, "light, rho 1.0", 60, 120, 210);
+    draw_finish(&pic, path, label);
 }
 
 int main(int argc, char** argv) {
@@ -114,10 +105,8 @@ int main(int argc, char** argv) {
         fprintf(stderr, "scene: %s\n", scene_error);
         return 1;
     }
-    snprintf(path, sizeof(path), "%s/multiphase_heavy.csv", dir);
-    csv = fopen(path, "w");
+    csv = draw_fopen(dir, "multiphase_heavy.csv");
     if (!csv) {
-        fprintf(stderr, "cannot write to %s/ (create the directory first)\n", dir);
         sph_world_free(&w);
         return 1;
     }
@@ -141,7 +130,7 @@ int main(int argc, char** argv) {
         fprintf(csv, "%.3f,%.5f,%.5f,%.6f,%.6f\n", w.time, b.y_heavy, ylow, b.pe,
                 w.steps ? w.stats.kinetic_energy : 0.0);
         snprintf(label, sizeof(label), "t = %.2f s  heavy CoM y = %.3f", w.time, b.y_heavy);
-        snprintf(path, sizeof(path), "%s/multiphase_%04d.png", dir, frame);
+        draw_frame_path(path, sizeof(path), dir, "multiphase", frame);
         render(&w, path, label);
         printf("%5d %6.2f %9.4f %9.3f %10.3e %7llu %8.3f %8.4f\n", frame, w.time, b.y_heavy, ylow,
                w.steps ? w.stats.kinetic_energy : 0.0, (unsigned long long)w.steps,

@@ -566,12 +566,32 @@ int main(int argc, char** argv) {
     d.margin = 0.01 + spacing(d.particles, NULL) * ceil(d.margin - 1e-9);
     d.scale = WIN_W / (TANK_W + 2 * d.margin);
     win_h = HUD_H + (int)ceil((TANK_H + 2 * d.margin) * d.scale);
+#if defined(__unix__) && !defined(__APPLE__)
+    /* an interactive run needs a display: without one SDL may open an invisible window (or a
+       console video driver) and the demo would run unseen until killed */
+    if (frames == 0 && !getenv("DISPLAY") && !getenv("WAYLAND_DISPLAY") &&
+        !getenv("SDL_VIDEODRIVER")) {
+        fprintf(stderr, "realtime: no display (neither DISPLAY nor WAYLAND_DISPLAY is set); run "
+                        "headless with --frames N, e.g.\n  xvfb-run -a %s --frames 150 "
+                        "--screenshot out/realtime.png\n", argv[0]);
+        return 1;
+    }
+#endif
     ren = open_window(WIN_W, win_h, frames > 0, &win);
+    if (ren && frames == 0 && SDL_GetCurrentVideoDriver() &&
+        (strcmp(SDL_GetCurrentVideoDriver(), "offscreen") == 0 ||
+         strcmp(SDL_GetCurrentVideoDriver(), "dummy") == 0)) {
+        fprintf(stderr, "realtime: video driver %s shows nothing; an interactive run needs a "
+                        "display (headless: --frames N [--screenshot out.png])\n",
+                SDL_GetCurrentVideoDriver());
+        SDL_Quit();
+        return 1;
+    }
     if (ren) /* the text band's texture */
         tex = SDL_CreateTexture(ren, SDL_PIXELFORMAT_RGB24, SDL_TEXTUREACCESS_STREAMING, WIN_W,
                                 HUD_H);
     if (!tex || !img_init(&hud, WIN_W, HUD_H)) {
-        fprintf(stderr, "realtime: no window (video driver %s): %s\n",
+        fprintf(stderr, "realtime: no window (video driver %s): %s (headless: --frames N)\n",
                 SDL_GetCurrentVideoDriver() ? SDL_GetCurrentVideoDriver() : "none", SDL_GetError());
         SDL_Quit();
         return 1;

@@ -29,7 +29,7 @@ SCENE_FN sph_status scene__fail(sph_world* w, sph_status s) {
     do { sph_status scene_s_ = (expr); if (scene_s_ != SPH_OK) return scene__fail(w, scene_s_); } \
     while (0)
 
-/* Hydrostatic tank (Adami, Hu & Adams 2012 sec. 6, validation-data.md sec. 4): water of depth
+/* Hydrostatic tank (Adami, Hu & Adams 2012 sec. 6): water of depth
    `depth` [m] in a tank `width` [m] wide (and deep in 3D), walls `wall_height` = 1.4 depth high
    with an open top, `res` particles over the depth, initialised in hydrostatic equilibrium. */
 SCENE_FN sph_status scene_hydrostatic(sph_world* w, sph_world_def def, double width, double depth,
@@ -53,7 +53,7 @@ SCENE_FN sph_status scene_hydrostatic(sph_world* w, sph_world_def def, double wi
     return SPH_OK;
 }
 
-/* Dam break after Martin & Moyce 1952 (validation-data.md sec. 1): a water column a wide and
+/* Dam break after Martin & Moyce 1952: a water column a wide and
    2a high (n^2 = 2) at the left end of a closed tank 5a long and 3a high (a deep in 3D), `res`
    particles over a. Gravity -9.81 along y. */
 typedef struct scene_dam {
@@ -82,7 +82,7 @@ SCENE_FN sph_status scene_dam_break(sph_world* w, sph_world_def def, double a, i
     return SPH_OK;
 }
 
-/* Stirrer after seed 003 sec. 5.1.2: an oval container (semi-axes 0.5 m x 0.35 m, one layer of
+/* Stirrer after Meiers 2025 sec. 5.1.2: an oval container (semi-axes 0.5 m x 0.35 m, one layer of
    wall particles at spacing dx) holds water up to `fill` of its height, stirred by a rotor at the
    centre: a hub of radius 0.06 m and three blades 0.2 m long whose particles are spaced
    non-uniformly (from 0.5 dx at the hub to 1.0 dx at the tip), rotating at omega [rad/s].
@@ -208,8 +208,8 @@ SCENE_FN double scene_stirrer_extent(const sph_world* w, const scene_stirrer* st
     return worst;
 }
 
-/* Rayleigh-Taylor instability (validation-data.md sec. 5; seed 000 sec. 5.4): a closed 1 x 2 box,
-   heavy fluid (1.8) above light (1.0), interface y = 1 - 0.15 sin(2 pi x), g = -1, kinematic
+/* Rayleigh-Taylor instability (Cummins & Rudman 1999; Enhanced PCISPH 2018 sec. 5.4): a closed 1 x
+   2 box, heavy fluid (1.8) above light (1.0), interface y = 1 - 0.15 sin(2 pi x), g = -1, kinematic
    viscosity 1/420 for both (Re = 420), no-slip walls, `res` particles per unit length. Phase 0
    is the light fluid, phase 1 the heavy one. */
 SCENE_FN sph_status scene_rayleigh_taylor(sph_world* w, sph_world_def def, int res) {
@@ -265,12 +265,11 @@ SCENE_FN double scene_dam_front(const sph_world* w, const scene_dam* d) {
     return (xmax + 0.5 * w->dx) / d->a;
 }
 
-
-/* Taylor-Green vortex (seed 002 sec. III B, validation-data.md): unit periodic box, U = 1 m/s,
+/* Taylor-Green vortex (Negi & Ramachandran 2022 sec. III B): unit periodic box, U = 1 m/s,
    rho0 = 1, Re = 100 (nu = 0.01 m^2/s), N x N particles on the lattice, quintic spline with
    h = 1.2 dx unless def says otherwise, no gravity; velocity and pressure of the exact solution
-   at t = 0, the fluid density from the Tait law's inverse (seed 002: "rho by inverting the
-   EOS"). The exact field at time t: scene_tg_exact. */
+   at t = 0, the fluid density from the Tait law's inverse (Negi & Ramachandran 2022: "rho by
+   inverting the EOS"). The exact field at time t: scene_tg_exact. */
 #define SCENE_TG_PI 3.14159265358979323846
 SCENE_FN void scene_tg_exact(double x, double y, double t, double* u, double* v, double* p) {
     const double b = -8 * SCENE_TG_PI * SCENE_TG_PI / 100, e = exp(b * t);
@@ -312,7 +311,8 @@ SCENE_FN sph_status scene_taylor_green(sph_world* w, sph_world_def def, int N, d
 
 /* Errors against the exact solution at w->time: mean |(|u| - |u_exact|)| and mean |p - p_exact|
    with the mean pressure removed (a weakly compressible run carries a constant offset), both
-   over the particles (seed 002 eq. 36 at one instant); ke_ratio = kinetic energy / exact. */
+   over the particles (Negi & Ramachandran 2022 eq. 36 at one instant); ke_ratio = kinetic energy /
+   exact. */
 SCENE_FN void scene_tg_errors(const sph_world* w, double* l1_u, double* l1_p, double* ke_ratio) {
     double eu = 0, ep = 0, pm = 0, ke = 0, ke_ex = 0;
     size_t i;
@@ -332,7 +332,7 @@ SCENE_FN void scene_tg_errors(const sph_world* w, double* l1_u, double* l1_p, do
 }
 
 /* Martin & Moyce 1952, Table 2 (n^2 = 2, a = 2.25 in): surge front Z = x/a against
-   T = t sqrt(2 g / a) (validation-data.md sec. 1 A). */
+   T = t sqrt(2 g / a). */
 static const double scene_mm_T[] = {0.41, 0.84, 1.19, 1.43, 1.63, 1.83, 1.98, 2.20,
                                      2.32, 2.51, 2.65, 2.83, 2.98, 3.11, 3.33};
 static const double scene_mm_Z[] = {1.11, 1.22, 1.44, 1.67, 1.89, 2.11, 2.33, 2.56,
@@ -342,7 +342,7 @@ static const double scene_mm_Z[] = {1.11, 1.22, 1.44, 1.67, 1.89, 2.11, 2.33, 2.
 /* Time [s] of Martin & Moyce's nondimensional time T for column width a [m]. */
 SCENE_FN double scene_mm_time(double T, double a) { return T / sqrt(2 * 9.81 / a); }
 
-/* Lid-driven cavity (Ghia, Ghia & Shin 1982; validation-data.md sec. 2): fluid of rest density
+/* Lid-driven cavity (Ghia, Ghia & Shin 1982): fluid of rest density
    1 kg/m^3 filling the unit square, no gravity, kinematic viscosity nu = U L / Re [m^2/s] with
    U = SCENE_CAVITY_U = 1 m/s and L = 1 m, sound speed 10 U (PySPH's cavity.py), no-slip walls
    (Adami's extrapolated wall velocity). Body 0 is the fixed box (bottom and sides), body 1 the
@@ -405,7 +405,7 @@ SCENE_FN sph_status scene_cavity(sph_world* w, sph_world_def def, int res, doubl
 
 /* Ghia, Ghia & Shin 1982, J. Comput. Phys. 48, 387-411, Re = 100: Table I, u along the vertical
    centre line x = 0.5 (at y = scene_ghia_y), and Table II, v along the horizontal centre line
-   y = 0.5 (at x = scene_ghia_x); unit cavity, lid u = 1 at y = 1 (validation-data.md sec. 2). */
+   y = 0.5 (at x = scene_ghia_x); unit cavity, lid u = 1 at y = 1 (Ghia, Ghia & Shin 1982). */
 #define SCENE_GHIA_N 17
 static const double scene_ghia_y[] = {1.0000, 0.9766, 0.9688, 0.9609, 0.9531, 0.8516,
                                        0.7344, 0.6172, 0.5000, 0.4531, 0.2813, 0.1719,
@@ -422,7 +422,7 @@ static const double scene_ghia_v100[] = {0.00000,  -0.05906, -0.07391, -0.08864,
                                           0.17507,  0.16077,  0.12317,  0.10890,  0.10091,
                                           0.09233,  0.00000};
 
-/* Two-layer tank (validation-data.md sec. 4; seed 000 sec. 5.3): scene_hydrostatic's tank with
+/* Two-layer tank (Enhanced PCISPH 2018 sec. 5.3): scene_hydrostatic's tank with
    water (rho0 = 1000 kg/m^3) below depth/2 and a phase of rest density ratio * rho0 above, up
    to `depth` [m], `res` particles over the depth, both at the same spacing (so the particle
    masses differ by the ratio), initialised in hydrostatic equilibrium. Phase 0 is the water.
@@ -456,7 +456,7 @@ SCENE_FN sph_status scene_two_layer(sph_world* w, sph_world_def def, double widt
 }
 
 /* p = rho1 g (H - y) above the interface H/2, rho1 g H/2 + rho0 g (H/2 - y) below it
-   (validation-data.md sec. 4), rho0 = 1000, rho1 = ratio rho0. */
+   (hydrostatics), rho0 = 1000, rho1 = ratio rho0. */
 SCENE_FN double scene_two_layer_p(double y, double depth, double ratio, double g) {
     const double r0 = 1000, r1 = 1000 * ratio, H = depth;
     return y > H / 2 ? r1 * g * (H - y) : r1 * g * H / 2 + r0 * g * (H / 2 - y);

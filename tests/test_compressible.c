@@ -1,6 +1,7 @@
 /* tests/test_compressible.c - the compressible multiphase step and the Ott-Schnetter particle-
-   density continuity (seed 004), against exact solutions: Toro's Riemann problems, seed 004's
-   advection, sound wave and air | Diesel shock tube, and an interface at rest at 1000:1. */
+   density continuity (Ott & Schnetter 2003), against exact solutions: Toro's Riemann problems, Ott
+   & Schnetter 2003's advection, sound wave and air | Diesel shock tube, and an interface at rest at
+   1000:1. */
 #include "../sph.h"
 #include "harness.h"
 #include "riemann.h"
@@ -138,8 +139,8 @@ static void test_riemann_toro(void) {
     }
 }
 
-/* Seed 004's air | Diesel problem with Diesel as a stiffened gas (gamma = 11, p_inf from
-   c = 1059.6 m/s): the exact shock relations of its Table 2 (digest). */
+/* Ott & Schnetter 2003's air | Diesel problem with Diesel as a stiffened gas (gamma = 11, p_inf
+   from c = 1059.6 m/s): the exact shock relations of its Table 2. */
 static rm_solution diesel_exact(void) {
     const double rhoD = 772.546, pD = 5e6, cD = 1059.6, gD = 11;
     rm_state L = {88.1, 0, 1e7, 1.4, 0};
@@ -176,9 +177,9 @@ typedef struct tube_result {
     char error[SPH_ERROR_SIZE];
 } tube_result;
 
-/* Seed 004 sec. 3.3: air (ideal gas, gamma 1.4) on [-0.8, 0), Diesel (stiffened gas fitted to
-   c = 1059.6 m/s) on [0, 2.2), periodic (the second interface at 2.2 = -0.8 stays more than
-   0.5 m from everything measured), cubic spline with h = 5 dx (0.05 m at the paper's 100
+/* Ott & Schnetter 2003 sec. 3.3: air (ideal gas, gamma 1.4) on [-0.8, 0), Diesel (stiffened gas
+   fitted to c = 1059.6 m/s) on [0, 2.2), periodic (the second interface at 2.2 = -0.8 stays more
+   than 0.5 m from everything measured), cubic spline with h = 5 dx (0.05 m at the paper's 100
    particles per metre), alpha = 0.5, beta = 0, to t = 5e-4 s. The plateau is measured between
    the contact's spike (2h) and the shock's foot (3h before the half point). */
 static tube_result shock_tube(double dx, sph_density density, sph_pressure_grad pgrad,
@@ -288,7 +289,7 @@ static void test_shock_tube(void) {
     tube_result r, r2, std_mp, std_sym, part_sym;
     double xs[801], ps[801];
     int k;
-    svg_begin(&ch, "Air | Diesel shock tube (seed 004), t = 0.5 ms, 100 particles/m", "x [m]", "p [MPa]");
+    svg_begin(&ch, "Air | Diesel shock tube (Ott & Schnetter 2003), t = 0.5 ms, 100 particles/m", "x [m]", "p [MPa]");
     for (k = 0; k <= 800; ++k) {
         double rho, u, p;
         int side;
@@ -353,10 +354,10 @@ static void test_shock_tube(void) {
             std_sym.steps, std_sym.error, part_sym.steps, part_sym.error);
     CHECK(std_sym.status == SPH_ERR_UNSTABLE && std_sym.steps < 20);
     CHECK(part_sym.status == SPH_ERR_UNSTABLE && part_sym.steps < 20);
-    save_chart(&ch, "seed004_shock_tube");
+    save_chart(&ch, "ott_schnetter_shock_tube");
 }
 
-/* ---- advection (seed 004 sec. 3.1) ---------------------------------------------------------- */
+/* ---- advection (Ott & Schnetter 2003 sec. 3.1) ----------------------------------------------- */
 
 /* A pressureless gas moves with the prescribed v(x) = x / (1 + q x^2); its exact density follows
    the characteristics: the label X of the particle at x at time t solves
@@ -447,7 +448,7 @@ static void test_advection(void) {
     svg_chart ch;
     sph_status s;
     int k;
-    svg_begin(&ch, "Advection (seed 004 sec. 3.1): density", "x", "rho");
+    svg_begin(&ch, "Advection (Ott & Schnetter 2003 sec. 3.1): density", "x", "rho");
     for (k = 4; k <= 8; k += 4) { /* exact curves at t = 4 and 8 */
         double xv[1000], rv[1000];
         int q;
@@ -484,10 +485,10 @@ static void test_advection(void) {
         CHECK(es[k] > 3 * ep6[k]);
     }
     if (s == SPH_OK) CHECK(ps[4] < 0.9 * xs2[4] && fabs(pp6[4] - xp6[4]) < 0.02 * xp6[4]);
-    save_chart(&ch, "seed004_advection");
+    save_chart(&ch, "ott_schnetter_advection");
 }
 
-/* ---- sound wave through a 10:1 interface (seed 004 sec. 3.2) -------------------------------- */
+/* ---- sound wave through a 10:1 interface (Ott & Schnetter 2003 sec. 3.2) --------------------- */
 
 typedef struct wave_result {
     sph_status status;
@@ -581,7 +582,7 @@ static void test_sound_wave(void) {
     wave_result p, s;
     double xv[1001], pv[1001];
     int k;
-    svg_begin(&ch, "Sound pulse through a 10:1 interface (seed 004 sec. 3.2), 1.0 after impact",
+    svg_begin(&ch, "Sound pulse through a 10:1 interface (Ott & Schnetter 2003 sec. 3.2), 1.0 after impact",
               "x", "p' / A");
     for (k = 0; k <= 1000; ++k) { /* the acoustic solution: two Gaussians */
         const double x = -2 + 5.0 * k / 1000;
@@ -600,7 +601,7 @@ static void test_sound_wave(void) {
     CHECK_NEAR(p.R, R, 0.03 * R);
     CHECK_NEAR(p.T, T, 0.03 * T);
     CHECK(fabs(s.R - R) > 5 * fabs(p.R - R) && fabs(s.T - T) > 5 * fabs(p.T - T));
-    save_chart(&ch, "seed004_sound_wave");
+    save_chart(&ch, "ott_schnetter_sound_wave");
 }
 
 /* ---- Sod's shock tube in 1D, 2D and 3D -------------------------------------------------------- */

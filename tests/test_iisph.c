@@ -1,4 +1,4 @@
-/* tests/test_iisph.c - implicit incompressible SPH (seed 003): a hydrostatic column held to
+/* tests/test_iisph.c - implicit incompressible SPH (Meiers 2025): a hydrostatic column held to
    0.1 % compression, iteration counts against depth and time step, the three boundary pressure
    schemes, single-layer walls, a rotating non-uniformly sampled stirrer, a lifting piston, the
    time-step sweet spot, and thread determinism. */
@@ -118,7 +118,7 @@ static void test_hydrostatic_column(void) {
     CHECK_EQ_INT(r.outside, 0);
 }
 
-/* Seed 003 Fig. 6: mean iterations grow with the fluid's depth (fixed dt) and with dt (fixed
+/* Meiers 2025 Fig. 6: mean iterations grow with the fluid's depth (fixed dt) and with dt (fixed
    depth); asserted as strictly increasing over three points each. */
 static void test_iterations_grow(void) {
     sph_world_def def = sph_world_def_default(2);
@@ -134,7 +134,7 @@ static void test_iterations_grow(void) {
 }
 
 /* The three boundary pressure schemes hold a tank at rest: no particle passes a wall in 4 s and
-   the compression stays at 0.1 % (extrapolation) or within 0.2 %. Seed 003 sec. 5.3: zero
+   the compression stays at 0.1 % (extrapolation) or within 0.2 %. Meiers 2025 sec. 5.3: zero
    pressure puts the weight on the wall-adjacent layer (its pressure runs well above hydrostatic),
    mirroring and extrapolation do not. The wall-adjacent pressure errors are reported. */
 static void test_boundary_schemes(void) {
@@ -180,7 +180,7 @@ static void test_single_layer_walls(void) {
 
 /* ---- moving boundaries --------------------------------------------------------------------- */
 
-/* Seed 003 sec. 5.1.2: the stirrer (oval single-layer container, three-blade rotor sampled from
+/* Meiers 2025 sec. 5.1.2: the stirrer (oval single-layer container, three-blade rotor sampled from
    0.5 dx to dx) turning at half a revolution per second: no particle leaves the oval, no blow-up,
    and after the first three steps (the lattice start next to the curved walls is 0.2 %
    compressed) the measured mean compression stays at or below 0.1 %. The actual compression
@@ -330,7 +330,7 @@ static void test_lifting_piston(void) {
     sph_world_free(&w);
 }
 
-/* ---- the time-step sweet spot (seed 003 Table 2) -------------------------------------------- */
+/* ---- the time-step sweet spot (Meiers 2025 Table 2) ------------------------------------------ */
 
 /* One column for 0.5 s at four time steps: larger steps need more iterations but fewer steps
    (both monotone); the table of iterations, steps and solver work is reported. make bench

@@ -1,6 +1,7 @@
-/* tests/test_operators.c - the corrected operators of seed 002 (Bonet & Lok gradient, divergence,
-   coupled Laplacian) on disordered points: exact for linear fields, second-order convergent,
-   where the uncorrected symmetric forms do not converge (seed 002 Tables VII and IX). */
+/* tests/test_operators.c - the corrected operators of Negi & Ramachandran 2022 (Bonet & Lok
+   gradient, divergence, coupled Laplacian) on disordered points: exact for linear fields,
+   second-order convergent, where the uncorrected symmetric forms do not converge (Negi &
+   Ramachandran 2022 Tables VII and IX). */
 #include "../sph.h"
 #include "harness.h"
 
@@ -30,7 +31,7 @@ typedef struct op_set {
 } op_set;
 
 /* N^dim points of a unit periodic box on the lattice (i + 1/2) ds, each moved by up to
-   +-jitter ds per direction; quintic spline with h = 1.2 ds (seed 002). */
+   +-jitter ds per direction; quintic spline with h = 1.2 ds (Negi & Ramachandran 2022). */
 static int op_set_init(op_set* s, int dim, int N, double jitter, int relax, unsigned long long seed) {
     const int per[3] = {1, 1, 1};
     const sph_real lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
@@ -82,9 +83,9 @@ static void op_set_free(op_set* s) {
     sph_neighbors_free(&s->nl);
 }
 
-/* The uncorrected symmetric forms the corrected ones replace (seed 002 Tables I, VIII): sym1 with
-   unit density, sum_j omega_j (f_i + f_j) grad W_ij, and Cleary's Laplacian
-   2 sum_j omega_j (f_i - f_j) (grad W_ij . x_ij) / r_ij^2. */
+/* The uncorrected symmetric forms the corrected ones replace (Negi & Ramachandran 2022 Tables I,
+   VIII): sym1 with unit density, sum_j omega_j (f_i + f_j) grad W_ij, and Cleary's Laplacian 2
+   sum_j omega_j (f_i - f_j) (grad W_ij . x_ij) / r_ij^2. */
 static void op_sym_gradient(const op_set* s, const sph_real* f, sph_real* grad) {
     size_t i, kk;
     int a;
@@ -120,9 +121,9 @@ static void op_cleary_laplacian(const op_set* s, const sph_real* f, sph_real* la
     }
 }
 
-/* Relative L1 errors (seed 002 eq. A2, x-components) of the operators for f = sin(2 pi (x + y))
-   (periodic on the unit box) and u = f (1, 1): err[0..4] = corrected gradient, divergence,
-   Laplacian, symmetric gradient, Cleary Laplacian. */
+/* Relative L1 errors (Negi & Ramachandran 2022 eq. A2, x-components) of the operators for f = sin(2
+   pi (x + y)) (periodic on the unit box) and u = f (1, 1): err[0..4] = corrected gradient,
+   divergence, Laplacian, symmetric gradient, Cleary Laplacian. */
 static void op_errors(int N, double jitter, int relax, double err[5]) {
     op_set s;
     sph_real *f, *u, *grad, *div, *lap, *tmp;
@@ -170,7 +171,8 @@ static void op_errors(int N, double jitter, int relax, double err[5]) {
     op_set_free(&s);
 }
 
-/* Least-squares slope of log(err) against log(1/N): the order of convergence (seed 002, fn. 8). */
+/* Least-squares slope of log(err) against log(1/N): the order of convergence (Negi & Ramachandran
+   2022, fn. 8). */
 static double op_order(const int* N, const double* e, int m) {
     double sx = 0, sy = 0, sxx = 0, sxy = 0;
     int q;
@@ -181,9 +183,9 @@ static double op_order(const int* N, const double* e, int m) {
     return (m * sxy - sx * sy) / (m * sxx - sx * sx);
 }
 
-/* Seed 002's operator study (Tables VII, IX) on its two kinds of point sets: "UP" with jitter (the
-   lattice, each point moved by up to +-0.2 ds), and "PP" (the same, relaxed by 10 iterations of
-   the shifting the scheme uses, as the paper's packed sets are). */
+/* Negi & Ramachandran 2022's operator study (Tables VII, IX) on its two kinds of point sets: "UP"
+   with jitter (the lattice, each point moved by up to +-0.2 ds), and "PP" (the same, relaxed by 10
+   iterations of the shifting the scheme uses, as the paper's packed sets are). */
 static void op_study(int relax, double ord[5], double fine[5]) {
     static const int N[4] = {25, 50, 100, 200};
     static const char* name[5] = {"corrected gradient", "corrected divergence",
@@ -207,8 +209,8 @@ static void test_op_convergence(void) {
     double ord[5], fine[5];
     op_study(10, ord, fine);
     if (sizeof(sph_real) == 8) { /* float round-off floors the fine grids */
-        /* seed 002: corrected gradient and divergence 1.98, coupled Laplacian 1.95; the
-           symmetric forms diverge (-0.55, -0.83) */
+        /* Negi & Ramachandran 2022: corrected gradient and divergence 1.98, coupled Laplacian 1.95;
+           the symmetric forms diverge (-0.55, -0.83) */
         CHECK(ord[0] > 1.9 && ord[1] > 1.9 && ord[2] > 1.8);
         CHECK(ord[3] < 0 && ord[4] < 0);
     }

@@ -1,7 +1,7 @@
-/* tests/test_pcisph.c - predictive-corrective incompressible SPH (seed 000): the original solver
-   and the enhanced engineering version on a tank at rest, the two-layer tank of seed 000 sec. 5.3
-   (where the original fails, and the library says so), the dam break against WCSPH and Martin &
-   Moyce, the Rayleigh-Taylor instability, and thread determinism. */
+/* tests/test_pcisph.c - predictive-corrective incompressible SPH (Enhanced PCISPH 2018): the
+   original solver and the enhanced engineering version on a tank at rest, the two-layer tank of
+   Enhanced PCISPH 2018 sec. 5.3 (where the original fails, and the library says so), the dam break
+   against WCSPH and Martin & Moyce, the Rayleigh-Taylor instability, and thread determinism. */
 #include "harness.h"
 #include "../sph.h"
 #include "../examples/scenes.h"
@@ -76,9 +76,9 @@ static pc_tank run_pc_tank(int enhanced) {
 
 /* Both variants hold a tank at rest with the predicted mean density error at the 0.01 %
    tolerance in every step (never at the iteration cap) and no particle through a wall; the
-   layer-averaged pressure follows rho g (H - y) to 1.5 %. Seed 000's point of the enhancements,
-   measured: the per-particle pressure error (noise) of the enhanced solver is at most half the
-   original's. */
+   layer-averaged pressure follows rho g (H - y) to 1.5 %. Enhanced PCISPH 2018's point of the
+   enhancements, measured: the per-particle pressure error (noise) of the enhanced solver is at most
+   half the original's. */
 static void test_pc_hydrostatic(void) {
     const pc_tank o = run_pc_tank(0), e = run_pc_tank(1);
     TH_NOTE("original PCISPH: %.1f iterations, max predicted error %.5f, pressure error layers %.4f, "
@@ -95,7 +95,7 @@ static void test_pc_hydrostatic(void) {
     CHECK_EQ_INT(o.outside + e.outside, 0);
 }
 
-/* ---- the two-layer tank (seed 000 sec. 5.3) ------------------------------------------------ */
+/* ---- the two-layer tank (Enhanced PCISPH 2018 sec. 5.3) -------------------------------------- */
 
 typedef struct two_layer {
     int failed;          /* the library reported SPH_ERR_UNSTABLE */
@@ -170,15 +170,15 @@ static two_layer run_two_layer(int enhanced, sph_density density, double ratio, 
     return r;
 }
 
-/* Seed 000 sec. 5.3 with density ratios 1, 0.8, 0.4, 0.2:
+/* Enhanced PCISPH 2018 sec. 5.3 with density ratios 1, 0.8, 0.4, 0.2:
    - the original PCISPH (summation density, which smears the mass jump) fails at every ratio
      below 1 within its first steps, and the library reports it (SPH_ERR_UNSTABLE);
-   - the enhanced solver with seed 000's continuity density stays at rest for 0.8 and 0.4 but
-     fails at 0.2 (reported): a light particle at the interface next to a wall takes the heavy
+   - the enhanced solver with Enhanced PCISPH 2018's continuity density stays at rest for 0.8 and
+   0.4 but fails at 0.2 (reported): a light particle at the interface next to a wall takes the heavy
      neighbours' masses in its density rate;
-   - with Ott-Schnetter's particle-density continuity (seed 004 eq. 11) it stays at rest at every
-     ratio: RMS speed below 2 % of sqrt(g H) (single particles below 15 %), no particle across
-     the interface, time- and layer-averaged pressure within 1 % of the two-layer profile.
+   - with Ott-Schnetter's particle-density continuity (Ott & Schnetter 2003 eq. 11) it stays at rest
+   at every ratio: RMS speed below 2 % of sqrt(g H) (single particles below 15 %), no particle
+   across the interface, time- and layer-averaged pressure within 1 % of the two-layer profile.
    (With equal densities both continuity forms are the same equation, so ratio 1 runs once.) */
 static void test_pc_two_layer(void) {
     static const double ratios[4] = {1, 0.8, 0.4, 0.2};
@@ -266,8 +266,8 @@ static db_run run_db(sph_world_def def) {
     return r;
 }
 
-/* Seed 000 Table 5.1: PCISPH takes steps 7.6-13 times WCSPH's. Here, at a comparable density
-   error (PCISPH tolerance 0.1 %, i.e. a mean compression at or below WCSPH's), both PCISPH
+/* Enhanced PCISPH 2018 Table 5.1: PCISPH takes steps 7.6-13 times WCSPH's. Here, at a comparable
+   density error (PCISPH tolerance 0.1 %, i.e. a mean compression at or below WCSPH's), both PCISPH
    variants take steps at least 8 times larger (dt capped at 1 ms: a first step at the force
    limit, from rest, is too large for the original's corrector that starts from zero pressure),
    and the surge front follows Martin & Moyce like WCSPH's (within 15 % RMS). The times to
@@ -298,7 +298,7 @@ static void test_pc_dam_break(void) {
     CHECK_LT(pe.front_rms, 0.15);
 }
 
-/* ---- Rayleigh-Taylor (seed 000 sec. 5.4) ---------------------------------------------------- */
+/* ---- Rayleigh-Taylor (Enhanced PCISPH 2018 sec. 5.4) ----------------------------------------- */
 
 /* Heavy over light (1.8 : 1), Re = 420, g = 1, 30 particles per unit, enhanced PCISPH with dt
    capped at 0.01: no blow-up to time T, the heavy spike (at x = 0.25, where the interface starts

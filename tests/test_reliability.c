@@ -156,7 +156,7 @@ static void test_slosh_violent(void) {
     slosh(solver_def(3), SPH_BP_EXTRAPOLATE, 0.5, 0.0125, 3.0, 1);
 }
 
-/* The rotating stirrer (seed 003): an oval single-layer container and a non-uniformly sampled
+/* The rotating stirrer (Meiers 2025): an oval single-layer container and a non-uniformly sampled
    rotor, Akinci volumes, every solver; no particle leaves the oval. */
 static void test_stirrer_confined(void) {
     int which;

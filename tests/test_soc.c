@@ -1,5 +1,6 @@
-/* tests/test_soc.c - the second-order convergent WCSPH scheme of seed 002 (L-IPST-C): Taylor-Green
-   convergence, kinetic-energy decay, the plain WCSPH step for contrast, 3D, and its input rules. */
+/* tests/test_soc.c - the second-order convergent WCSPH scheme of Negi & Ramachandran 2022
+   (L-IPST-C): Taylor-Green convergence, kinetic-energy decay, the plain WCSPH step for contrast,
+   3D, and its input rules. */
 #include "../sph.h"
 #include "harness.h"
 #include "../examples/scenes.h"
@@ -18,7 +19,8 @@ typedef struct tg_result {
     int steps;
 } tg_result;
 
-/* Taylor-Green, Re 100, N^2 particles, c0, to t_end with dt = 0.3 h / (U + c0) (seed 002). */
+/* Taylor-Green, Re 100, N^2 particles, c0, to t_end with dt = 0.3 h / (U + c0) (Negi & Ramachandran
+   2022). */
 static tg_result run_tg(int N, double c0, double t_end, int second_order) {
     sph_world_def def = sph_world_def_default(2);
     sph_world w;
@@ -53,9 +55,9 @@ static tg_result run_tg(int N, double c0, double t_end, int second_order) {
     return r;
 }
 
-/* Seed 002 sec. III B: L-IPST-C converges at second order in velocity (Table IV: 1.38 ... 1.93 for
-   c0 = 20 ... 80 over 50^2 ... 500^2). Here c0 = 20, t = 0.5 s, 20^2 and 40^2 (make validate adds
-   80^2; bench/convergence.c the full study). */
+/* Negi & Ramachandran 2022 sec. III B: L-IPST-C converges at second order in velocity (Table
+   IV: 1.38 ... 1.93 for c0 = 20 ... 80 over 50^2 ... 500^2). Here c0 = 20, t = 0.5 s, 20^2 and 40^2
+   (make validate adds 80^2; bench/convergence.c the full study). */
 static void test_soc_taylor_green(void) {
     const tg_result a = run_tg(20, 20, 0.5, 1), b = run_tg(40, 20, 0.5, 1);
     const tg_result plain = run_tg(20, 20, 0.5, 0);
@@ -73,17 +75,17 @@ static void test_soc_taylor_green(void) {
     /* the decay of kinetic energy, e^{2bt}: within 5 % at 40^2, the error shrinking ~4x */
     CHECK(fabs(b.ke_ratio - 1) < 0.05);
     CHECK(fabs(b.ke_ratio - 1) < 0.35 * fabs(a.ke_ratio - 1));
-    /* the corrected operators do not conserve momentum exactly (seed 002: F_T/F_max 1e-5..1e-4);
-       the drift is bounded here, not asserted to vanish. In float the non-cancelling round-off
-       of the asymmetric sums dominates it (2e-3 at 20^2 and 40^2, against 9e-6 and 3e-4 in
-       double), hence the separate bound. */
+    /* the corrected operators do not conserve momentum exactly (Negi & Ramachandran 2022: F_T/F_max
+       1e-5..1e-4); the drift is bounded here, not asserted to vanish. In float the non-cancelling
+       round-off of the asymmetric sums dominates it (2e-3 at 20^2 and 40^2, against 9e-6 and 3e-4
+       in double), hence the separate bound. */
     CHECK(b.momentum < (sizeof(sph_real) == 4 ? 1e-2 : 1e-3));
     CHECK(plain.status != SPH_OK || plain.l1_u > 3 * a.l1_u);
 }
 
 /* Without the shifting (def.shift_every = 0) the asymmetric pressure gradient, which has no
-   redistributing background pressure, lets particles clump (seed 002 sec. II D 1): the run
-   blows up, and the step reports it rather than going on silently. */
+   redistributing background pressure, lets particles clump (Negi & Ramachandran 2022 sec. II D 1):
+   the run blows up, and the step reports it rather than going on silently. */
 static void test_soc_needs_shifting(void) {
     sph_world_def def = sph_world_def_default(2);
     sph_world w;

@@ -122,7 +122,7 @@ static void test_dam_break_fixed_dt(void) {
     }
 }
 
-/* Two-layer tank (validation-data.md sec. 4), 10 particles deep, WCSPH with the multiphase
+/* Two-layer tank (Enhanced PCISPH 2018 sec. 5.3), 10 particles deep, WCSPH with the multiphase
    pressure gradient (Ott & Schnetter eq. 12), t = 1.5 s at the stable step: mean |p - p_exact| /
    (rho0 g H) over particles a support away from walls and surface, pressures averaged per
    particle over t in [1, 1.5] s. Returns the status; *err the error. */
