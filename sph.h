@@ -894,6 +894,9 @@ typedef struct sph__private {
                                        current sub-step's start [1] (rollback)                      */
     size_t snap_cap[2];             /* bytes                                                        */
     double dt_factor;               /* sph_advance: factor on sph_stable_dt (failed steps shrink it) */
+    double correct_fraction;        /* PCISPH, IISPH: the fraction of the compression standing at
+                                       the step's start that the step corrects, dt / dt_rule when
+                                       sph_advance shortened the step below the rule, else 1    */
 } sph__private;
 
 /* The world: a caller-owned plain struct. Read the arrays directly; positions and velocities may
@@ -4237,6 +4240,20 @@ static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, s
     return sph__integrate_with(w, c, w->a, kv, kr, kx, final);
 }
 
+/* The share of the compression standing at a step's start that PCISPH and IISPH leave for later
+   steps. Both solves drive the predicted density to rho0 within the step, so a standing
+   compression delta is removed by a velocity of about delta dx / dt: the smaller the step, the
+   harder the kick. When sph_advance retries a failed step at half the size, that kick would
+   double and the retry fail harder (with an ever smaller step it grows without bound). A step
+   shortened below the solver's rule dt_rule therefore corrects only dt / dt_rule of the
+   standing compression (as a Baumgarte-stabilised constraint: the correction velocity stays that
+   of the rule's step) and the rest in the steps that follow. sph_step_* called directly correct
+   all of it. */
+static sph_real sph__standing_keep(const sph_world* w) {
+    const double f = w->priv.correct_fraction;
+    return f > 0 && f < 1 ? (sph_real)(1 - f) : 0;
+}
+
 /* The end of an iterative solve above its tolerance: the step was taken with the last pressure,
    and the caller hears of it (sph_advance undoes the step and retries a smaller one). */
 static sph_status sph__not_converged(sph_world* w, const char* solver, int it, double err,
@@ -5061,6 +5078,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
        drift for summation), so the gain doubles */
     const double S = (summation ? (double)w->priv.lattice_sum : 1.0) * (verlet ? 2.0 : 1.0);
     double t0 = sph__now(), tstart = t0, err = 0, errmax = 0, proto[SPH_MAX_PHASES];
+    sph_real keep;
     uint64_t sorts;
     sph__ctx c;
     sph_status s;
@@ -5133,6 +5151,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
         w->p[i] = w->p[i] > 0 ? w->def.warm_start * w->p[i] : 0; /* Alg. 5: warm_start = 0 */
     }
     memset(w->priv.ap, 0, nD * sizeof(sph_real));
+    keep = sph__standing_keep(w);
     /* predict and correct */
     for (;;) {
         const size_t nb2 = nblk;
@@ -5163,7 +5182,8 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
             double e = 0, emax = 0;
             size_t j;
             for (j = i0; j < i1; ++j) {
-                const sph_real r0 = c.pc[w->phase[j]].rho0, drho = w->rho[j] - r0;
+                const sph_real r0 = c.pc[w->phase[j]].rho0, rn = w->priv.rho_n[j];
+                const sph_real drho = w->rho[j] - r0 - keep * (rn > r0 ? rn - r0 : 0);
                 const sph_real p = w->p[j] + w->priv.aii[j] * drho;
                 const double comp = drho > 0 ? (double)(drho / r0) : 0.0;
                 w->p[j] = p > 0 ? p : 0;
@@ -5310,7 +5330,8 @@ SPH__INLINE void sph__iisph_prepare_one(const sph_world* w, const sph__ctx* c, s
     /* density sums are normalised by the lattice sum S (sph__stage_density_summation), so are
        their rates of change */
     w->priv.aii[i] = dt * dt * (-dot * inv_r2 - mi * inv_r2 * Q) / w->priv.lattice_sum;
-    w->priv.src[i] = P->rho0 - (rhoi + dt * R / w->priv.lattice_sum);
+    w->priv.src[i] = P->rho0 - (rhoi + dt * R / w->priv.lattice_sum) +
+                     sph__standing_keep(w) * (rhoi > P->rho0 ? rhoi - P->rho0 : 0);
 }
 
 /* (A p)_i from the pressure accelerations, the Jacobi update of p_i (in place: A p reads only
@@ -5797,7 +5818,9 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
             }
         }
         ++substeps;
+        w->priv.correct_fraction = fmin(1.0, dt / dt_stable);
         s = sph_step(w, (sph_real)dt);
+        w->priv.correct_fraction = 1;
         if (s == SPH_OK) {
             if (dt_min == 0 || dt < dt_min) dt_min = dt;
             in_row = 0;
