@@ -5459,9 +5459,8 @@ static double sph__dfsph_error(sph_world* w, const sph__ctx* c, sph_real dt, int
             const sph__phase_c* P = &c->pc[c->ph[i]];
             sph_real r = w->drho[i] * inv_s;
             if (density) r = w->rho[i] + dt * r - P->rho0;
-            r = r > 0 ? r : 0;
-            w->drho[i] = r;
-            e += (double)(density ? r * P->inv_rho0 : r * dt * P->inv_rho0);
+            w->drho[i] = r; /* signed: expansion lowers the pressure (to 0 at most) */
+            if (r > 0) e += (double)(density ? r * P->inv_rho0 : r * dt * P->inv_rho0);
         }
         w->priv.block[blk] = e;
     }
@@ -5472,13 +5471,16 @@ static double sph__dfsph_error(sph_world* w, const sph__ctx* c, sph_real dt, int
 /* The stiffness update of the error in w->drho: p_i += rho_i alpha_i (rho*_i - rho0_i)/dt^2
    (constant density), or K_i += D rho_i/Dt and p^v_i = rho_i alpha_i K_i / dt (divergence). */
 static void sph__dfsph_update(sph_world* w, sph_real dt, int density) {
+    const sph_real omega = w->def.omega;
     sph__idx i;
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) {
         if (density) {
-            w->p[i] += w->rho[i] * w->priv.df_alpha[i] * w->drho[i] / (dt * dt);
+            const sph_real p = w->p[i] + omega * w->rho[i] * w->priv.df_alpha[i] * w->drho[i] / (dt * dt);
+            w->p[i] = p > 0 ? p : 0;
         } else {
-            w->priv.df_kv[i] += w->drho[i];
+            const sph_real K = w->priv.df_kv[i] + omega * w->drho[i];
+            w->priv.df_kv[i] = K > 0 ? K : 0;
             w->priv.df_pv[i] = w->rho[i] * w->priv.df_alpha_v[i] * w->priv.df_kv[i] / dt;
         }
     }
