@@ -28,6 +28,7 @@ extern const th_test tests_wcsph[];
 extern const th_test tests_compile[];
 extern const th_test tests_iisph[];
 extern const th_test tests_iisph_long[]; /* long runs: only with --long (make validate) */
+extern const th_test tests_dfsph[];
 extern const th_test tests_pcisph[];
 extern const th_test tests_pcisph_long[];
 extern const th_test tests_operators[];
