@@ -71,7 +71,7 @@ static df_tank run_df_tank(sph_solver solver, int dim, sph_boundary_pressure bp,
     ps = (double*)calloc(w.n, sizeof(double));
     cn = (int*)calloc(w.n, sizeof(int));
     while (w.time < T - 1e-9) {
-        sph_status s = sph_step(&w, (sph_real)dt);
+        sph_status s = th_step(&w, (sph_real)dt);
         if (s == SPH_ERR_NOT_CONVERGED) { /* the step is complete: count it and go on */
             ++r.unconverged;
             r.unconverged_until = w.time;
@@ -215,7 +215,7 @@ static df_dam run_df_dam(sph_world_def def, int res) {
         double e;
         while (w.time < t - 1e-12) {
             const int last = dt >= t - w.time;
-            const sph_status s = sph_step(&w, (sph_real)(last ? t - w.time : dt));
+            const sph_status s = th_step(&w, (sph_real)(last ? t - w.time : dt));
             size_t out = 0;
             if (s != SPH_OK) {
                 TH_NOTE("dam break step %d: %s", r.steps, w.error); /* the caller checks */
@@ -386,7 +386,7 @@ static void test_df_divergence_solve(void) {
         id0[i] = w.id[i];
     }
     before = df_divergence(&w, x0, v0, id0, S, dt);
-    CHECK_EQ_INT(sph_step(&w, (sph_real)dt), SPH_OK);
+    CHECK_EQ_INT(th_step(&w, (sph_real)dt), SPH_OK);
     after = df_divergence(&w, x0, w.v, w.id, S, dt);
     TH_NOTE("divergence solve: mean compressive D rho/Dt dt / rho0 %.3e before, %.3e after "
             "(stats %.3e, tolerance %.0e) in %d iterations; density solve iterations %d",
@@ -450,7 +450,7 @@ static void test_df_enclosed_vortex(void) {
         dt = df_dt(&w, 1.0, 0);
         ke_prev = ke0;
         while (w.time < 1.0 - 1e-9) {
-            const sph_status s = sph_step(&w, (sph_real)dt);
+            const sph_status s = th_step(&w, (sph_real)dt);
             if (s == SPH_ERR_NOT_CONVERGED) ++unconverged; /* complete: go on */
             else if (s != SPH_OK) { CHECK_MSG(0, "vortex scheme %d: %s", bp, w.error); failed = 1; break; }
             ++steps;
@@ -537,7 +537,7 @@ static void test_df_paddle(void) {
         CHECK_EQ_INT(sph_set_hydrostatic(&w), SPH_OK);
         dt = df_dt(&w, 2 * sqrt(9.81 * H), 9.81);
         while (w.time < 1.0 - 1e-9) {
-            const sph_status s = sph_step(&w, (sph_real)dt);
+            const sph_status s = th_step(&w, (sph_real)dt);
             const double face = df_paddle_x(&pd, w.time - dt); /* the walls of the step */
             size_t out = 0;
             if (s != SPH_OK) { CHECK_MSG(0, "paddle scheme %d: %s", bp, w.error); failed = 1; break; }
@@ -579,7 +579,7 @@ static void test_df_determinism(void) {
         def.solver = SPH_SOLVER_DFSPH;
         CHECK_EQ_INT(scene_dam_break(w, def, 0.1, 40, NULL), SPH_OK);
         for (s = 0; s < 40; ++s) {
-            CHECK_EQ_INT(sph_step(w, (sph_real)5e-4), SPH_OK);
+            CHECK_EQ_INT(th_step(w, (sph_real)5e-4), SPH_OK);
             *(t == 1 ? &ita : &itb) += w->stats.iterations;
         }
     }

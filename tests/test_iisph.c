@@ -61,7 +61,7 @@ static tank_result run_tank(sph_world_def def, double H, int layers, int closed,
     cn = (int*)calloc(w.n, sizeof(int));
     r.lowest = 1e9;
     while (w.time < T - 1e-9) {
-        if (sph_step(&w, (sph_real)dt) != SPH_OK) {
+        if (th_step(&w, (sph_real)dt) != SPH_OK) {
             CHECK_MSG(0, "step %d: %s", r.steps, w.error);
             break;
         }
@@ -203,7 +203,7 @@ static void run_stirrer(double revolutions, int check) {
     while (w.time < revolutions * 2 - 1e-9) {
         sph_real dt = sph_stable_dt(&w, SPH_SOLVER_IISPH);
         if (dt > (sph_real)0.005) dt = (sph_real)0.005;
-        if (sph_step(&w, dt) != SPH_OK) {
+        if (th_step(&w, dt) != SPH_OK) {
             CHECK_MSG(0, "stirrer step %d: %s", steps, w.error);
             break;
         }
@@ -300,7 +300,7 @@ static void test_lifting_piston(void) {
         double y, v, a, pb = 0, cm = 0;
         const double t0 = w.time; /* the walls of this step are at its start time */
         size_t b, nb = 0;
-        if (sph_step(&w, (sph_real)dt) != SPH_OK) { CHECK_MSG(0, "piston: %s", w.error); break; }
+        if (th_step(&w, (sph_real)dt) != SPH_OK) { CHECK_MSG(0, "piston: %s", w.error); break; }
         comp = fmax(comp, w.stats.compression_avg);
         piston_kinematics(&lp, t0, &y, &v, &a);
         for (b = 0; b < w.nb; ++b) {
@@ -367,7 +367,7 @@ static void test_iisph_determinism(void) {
         omp_set_num_threads(t);
         def.solver = SPH_SOLVER_IISPH;
         CHECK_EQ_INT(scene_dam_break(w, def, 0.1, 24, NULL), SPH_OK);
-        for (s = 0; s < 60; ++s) CHECK_EQ_INT(sph_step(w, 1e-3), SPH_OK);
+        for (s = 0; s < 60; ++s) CHECK_EQ_INT(th_step(w, 1e-3), SPH_OK);
     }
     CHECK(a.n == b.n && memcmp(a.x, b.x, a.n * 2 * sizeof(sph_real)) == 0);
     CHECK(memcmp(a.v, b.v, a.n * 2 * sizeof(sph_real)) == 0);

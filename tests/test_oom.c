@@ -562,14 +562,14 @@ static void scen_wcsph(oom_ctx* C) {
     sph_real x[40];
     int i;
     OOM_PART(C, oom_tank(C, &def, 0));
-    OOM(C, w, sph_step(w, (sph_real)2e-4));
-    OOM(C, w, sph_step(w, (sph_real)2e-4));
+    OOM(C, w, th_step(w, (sph_real)2e-4));
+    OOM(C, w, th_step(w, (sph_real)2e-4));
     for (i = 0; i < 20; ++i) {
         x[2 * i] = (sph_real)(0.01 + 0.02 * i);
         x[2 * i + 1] = (sph_real)0.23;
     }
     OOM(C, w, sph_add_fluid(w, 0, 20, x, NULL));
-    OOM(C, w, sph_step(w, (sph_real)2e-4));
+    OOM(C, w, th_step(w, (sph_real)2e-4));
 }
 
 static void scen_wcsph_summation(oom_ctx* C) {
@@ -577,8 +577,8 @@ static void scen_wcsph_summation(oom_ctx* C) {
     sph_world_def def = oom_def2();
     def.density = SPH_DENSITY_SUMMATION;
     OOM_PART(C, oom_tank(C, &def, 0));
-    OOM(C, w, sph_step(w, (sph_real)2e-4));
-    OOM(C, w, sph_step(w, (sph_real)2e-4));
+    OOM(C, w, th_step(w, (sph_real)2e-4));
+    OOM(C, w, th_step(w, (sph_real)2e-4));
 }
 
 static void scen_wcsph_verlet(oom_ctx* C) {
@@ -586,9 +586,9 @@ static void scen_wcsph_verlet(oom_ctx* C) {
     sph_world_def def = oom_def2();
     def.integrator = SPH_INTEGRATOR_VERLET;
     OOM_PART(C, oom_tank(C, &def, 0));
-    OOM(C, w, sph_step(w, (sph_real)2e-4));
-    OOM(C, w, sph_step(w, (sph_real)2e-4));
-    OOM(C, w, sph_step(w, (sph_real)2e-4));
+    OOM(C, w, th_step(w, (sph_real)2e-4));
+    OOM(C, w, th_step(w, (sph_real)2e-4));
+    OOM(C, w, th_step(w, (sph_real)2e-4));
 }
 
 static void scen_pcisph(oom_ctx* C, int enhanced) {
@@ -596,8 +596,8 @@ static void scen_pcisph(oom_ctx* C, int enhanced) {
     sph_world_def def = oom_def2();
     sph_world_def_pcisph(&def, enhanced);
     OOM_PART(C, oom_tank(C, &def, 0));
-    OOM(C, w, sph_step(w, (sph_real)1e-3));
-    OOM(C, w, sph_step(w, (sph_real)1e-3));
+    OOM(C, w, th_step(w, (sph_real)1e-3));
+    OOM(C, w, th_step(w, (sph_real)1e-3));
 }
 static void scen_pcisph_original(oom_ctx* C) { scen_pcisph(C, 0); }
 static void scen_pcisph_enhanced(oom_ctx* C) { scen_pcisph(C, 1); }
@@ -618,7 +618,7 @@ static void scen_pcisph_blocks(oom_ctx* C) {
     OOM(C, w, oom_add_phase(w, &water, &ph));
     OOM(C, w, sph_fill_box(w, ph, lo, hi));
     for (i = 0; i < w->n; ++i) w->v[i] = (sph_real)0.1;
-    OOM(C, w, sph_step(w, (sph_real)1e-3));
+    OOM(C, w, th_step(w, (sph_real)1e-3));
 }
 
 static void scen_iisph(oom_ctx* C) {
@@ -626,8 +626,8 @@ static void scen_iisph(oom_ctx* C) {
     sph_world_def def = oom_def2();
     def.solver = SPH_SOLVER_IISPH;
     OOM_PART(C, oom_tank(C, &def, 0));
-    OOM(C, w, sph_step(w, (sph_real)2e-3));
-    OOM(C, w, sph_step(w, (sph_real)2e-3));
+    OOM(C, w, th_step(w, (sph_real)2e-3));
+    OOM(C, w, th_step(w, (sph_real)2e-3));
 }
 
 /* Compressible, 1D: Tait water, then two ideal gases (the internal energy array appears with
@@ -659,8 +659,8 @@ static void scen_compressible(oom_ctx* C) {
     OOM(C, w, sph_add_wall_box(w, l0, l3, 0, 0));
     dt = (sph_real)0.5 * sph_stable_dt(w, SPH_SOLVER_COMPRESSIBLE);
     CHECK(dt > 0);
-    OOM(C, w, sph_step(w, dt));
-    OOM(C, w, sph_step(w, dt));
+    OOM(C, w, th_step(w, dt));
+    OOM(C, w, th_step(w, dt));
 }
 
 /* The second-order scheme: a periodic Taylor-Green box of 16 x 16, shifting every step. */
@@ -696,8 +696,8 @@ static void scen_second_order(oom_ctx* C) {
         w->v[2 * i + 1] = (sph_real)(sin(2 * pi * x) * cos(2 * pi * y));
     }
     dt = (sph_real)(0.3 * (double)w->h / 21);
-    OOM(C, w, sph_step(w, dt));
-    OOM(C, w, sph_step(w, dt));
+    OOM(C, w, th_step(w, dt));
+    OOM(C, w, th_step(w, dt));
 }
 
 /* Fault injection for the second-order scheme, whose first stage moves the particles before its
@@ -757,9 +757,9 @@ static void scen_second_order_midstep(oom_ctx* C) {
         w->x[2 * i] += (sph_real)(0.003 * sin(12.9898 * (double)i));
         w->x[2 * i + 1] += (sph_real)(0.003 * sin(78.233 * (double)i));
     }
-    OOM(C, w, sph_step(w, (sph_real)0.02));
+    OOM(C, w, th_step(w, (sph_real)0.02));
     CHECK(w->stats.iterations >= 2); /* shifted */
-    OOM(C, w, sph_step(w, (sph_real)0.02));
+    OOM(C, w, th_step(w, (sph_real)0.02));
 }
 
 /* Water under oil in a tank: the multiphase wall pressure (one per phase and wall particle). */
@@ -772,8 +772,8 @@ static void scen_multiphase_walls(oom_ctx* C) {
     OOM_PART(C, oom_tank(C, &def, 0));
     OOM(C, w, oom_add_phase(w, &oil, &ph));
     OOM(C, w, sph_fill_box(w, ph, lo, hi));
-    OOM(C, w, sph_step(w, (sph_real)2e-4));
-    OOM(C, w, sph_step(w, (sph_real)2e-4));
+    OOM(C, w, th_step(w, (sph_real)2e-4));
+    OOM(C, w, th_step(w, (sph_real)2e-4));
 }
 
 /* Walls that move sideways, so they are re-sorted every step. */
@@ -795,8 +795,8 @@ static void scen_akinci(oom_ctx* C) {
     def.boundary_volume = SPH_BVOL_AKINCI;
     def.boundary_motion = oom_slide;
     OOM_PART(C, oom_tank(C, &def, 1));
-    OOM(C, w, sph_step(w, (sph_real)2e-4));
-    OOM(C, w, sph_step(w, (sph_real)2e-4));
+    OOM(C, w, th_step(w, (sph_real)2e-4));
+    OOM(C, w, th_step(w, (sph_real)2e-4));
 }
 
 /* Akinci volumes of static walls with IISPH: volumes computed once, at the first step. */
@@ -807,8 +807,8 @@ static void scen_akinci_static(oom_ctx* C) {
     def.solver = SPH_SOLVER_IISPH;
     def.max_compression = 0; /* a single layer of gamma 1 weighs about three: dense at first */
     OOM_PART(C, oom_tank(C, &def, 1));
-    OOM(C, w, sph_step(w, (sph_real)2e-3));
-    OOM(C, w, sph_step(w, (sph_real)2e-3));
+    OOM(C, w, th_step(w, (sph_real)2e-3));
+    OOM(C, w, th_step(w, (sph_real)2e-3));
 }
 
 /* sph_grid_build / sph_neighbors_build on their own: a dense 2D grid that grows, a hashed grid
@@ -876,9 +876,9 @@ static void test_oom_none(void) {
     sph_world_free(w);
     oom_tank(&C, &def, 0);
     CHECK(!C.bad && !C.failed);
-    for (i = 0; i < 3; ++i) CHECK_EQ_INT(sph_step(w, (sph_real)2e-4), SPH_OK);
+    for (i = 0; i < 3; ++i) CHECK_EQ_INT(th_step(w, (sph_real)2e-4), SPH_OK);
     th_alloc_fail_at(0);
-    for (i = 0; i < 3; ++i) CHECK_EQ_INT(sph_step(w, (sph_real)2e-4), SPH_OK);
+    for (i = 0; i < 3; ++i) CHECK_EQ_INT(th_step(w, (sph_real)2e-4), SPH_OK);
     CHECK(sph_stable_dt(w, SPH_SOLVER_WCSPH) > 0);
     (void)sph_world_memory(w);
     (void)sph_world_mass(w);

@@ -44,7 +44,7 @@ static pc_tank run_pc_tank(int enhanced) {
     ps = (double*)calloc(w.n, sizeof(double));
     cn = (int*)calloc(w.n, sizeof(int));
     while (w.time < 1.0 - 1e-9) {
-        if (sph_step(&w, (sph_real)0.002) != SPH_OK) { CHECK_MSG(0, "step: %s", w.error); break; }
+        if (th_step(&w, (sph_real)0.002) != SPH_OK) { CHECK_MSG(0, "step: %s", w.error); break; }
         ++steps;
         its += w.stats.iterations;
         if (w.stats.iterations >= w.def.max_iterations) ++r.at_max;
@@ -137,7 +137,7 @@ static two_layer run_two_layer(int enhanced, sph_density density, double ratio, 
     ps = (double*)calloc(w.n, sizeof(double));
     cn = (int*)calloc(w.n, sizeof(int));
     while (w.time < T - 1e-9) {
-        if (sph_step(&w, (sph_real)0.002) != SPH_OK) {
+        if (th_step(&w, (sph_real)0.002) != SPH_OK) {
             r.failed = w.status == SPH_ERR_UNSTABLE;
             CHECK_MSG(r.failed, "two layers: unexpected error %s", w.error);
             break;
@@ -245,7 +245,7 @@ static db_run run_db(sph_world_def def) {
             double dt = (double)sph_stable_dt(&w, w.def.solver);
             const int last = dt >= t - w.time; /* no sliver steps from rounding (see sph_advance) */
             if (last) dt = t - w.time;
-            if (sph_step(&w, (sph_real)dt) != SPH_OK) { CHECK_MSG(0, "dam break: %s", w.error); k = SCENE_MM_N; break; }
+            if (th_step(&w, (sph_real)dt) != SPH_OK) { CHECK_MSG(0, "dam break: %s", w.error); k = SCENE_MM_N; break; }
             ++r.steps;
             r.dt_mean += dt;
             r.iterations += w.stats.iterations;
@@ -356,7 +356,7 @@ static void test_pc_determinism(void) {
         omp_set_num_threads(t);
         sph_world_def_pcisph(&def, 1);
         CHECK_EQ_INT(scene_dam_break(w, def, 0.1, 24, NULL), SPH_OK);
-        for (s = 0; s < 40; ++s) CHECK_EQ_INT(sph_step(w, 5e-4), SPH_OK);
+        for (s = 0; s < 40; ++s) CHECK_EQ_INT(th_step(w, 5e-4), SPH_OK);
     }
     CHECK(a.n == b.n && memcmp(a.x, b.x, a.n * 2 * sizeof(sph_real)) == 0);
     CHECK(memcmp(a.v, b.v, a.n * 2 * sizeof(sph_real)) == 0);

@@ -175,7 +175,7 @@ static void test_stirrer_confined(void) {
         while (w.time < 1.0 && s == SPH_OK) { /* half a revolution */
             sph_real dt = sph_stable_dt(&w, def.solver);
             if (dt > (sph_real)0.005) dt = (sph_real)0.005;
-            s = sph_step(&w, dt);
+            s = th_step(&w, dt);
             {
                 double e = scene_stirrer_extent(&w, &st);
                 if (e > extent) extent = e;
@@ -238,7 +238,7 @@ static void test_momentum_periodic(void) {
         sph_world_momentum(&w, P0);
         for (i = 0; i < w.n; ++i) scale += (double)w.mass * hypot((double)w.v[2 * i], (double)w.v[2 * i + 1]);
         for (step = 0; step < 50; ++step) {
-            CHECK_EQ_INT(sph_step(&w, sph_stable_dt(&w, def.solver)), SPH_OK);
+            CHECK_EQ_INT(th_step(&w, sph_stable_dt(&w, def.solver)), SPH_OK);
             sph_world_momentum(&w, P);
             for (k = 0; k < 2; ++k) worst = fmax(worst, fabs(P[k] - P0[k]) / scale);
         }
@@ -404,7 +404,7 @@ static uint64_t golden_run(int which, int threads, size_t* n) {
 #endif
     CHECK_EQ_INT(golden_scene(which, &w), SPH_OK);
     for (k = 0; k < 6; ++k) {
-        sph_status s = sph_step(&w, sph_stable_dt(&w, w.def.solver));
+        sph_status s = th_step(&w, sph_stable_dt(&w, w.def.solver));
         CHECK_MSG(s == SPH_OK, "%s", w.error);
         if (s != SPH_OK) break;
     }

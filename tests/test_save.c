@@ -21,7 +21,7 @@ static sph_status steps(sph_world* w, int count) {
     int k;
     for (k = 0; k < count; ++k) {
         sph_real dt = fixed_dt > 0 ? fixed_dt : sph_stable_dt(w, w->def.solver);
-        sph_status s = sph_step(w, dt);
+        sph_status s = th_step(w, dt);
         if (s != SPH_OK) return s;
     }
     return SPH_OK;
@@ -305,7 +305,7 @@ static void test_blowup_retry(void) {
     CHECK_EQ_INT(sph_world_copy(&checkpoint, &w), SPH_OK);
     CHECK_EQ_INT(sph_world_copy(&reference, &w), SPH_OK);
     for (k = 0; k < 400 && s == SPH_OK; ++k) {
-        s = sph_step(&w, 8 * sph_stable_dt(&w, w.def.solver));
+        s = th_step(&w, 8 * sph_stable_dt(&w, w.def.solver));
         if (s != SPH_OK) failed_at = k;
     }
     CHECK_EQ_INT(s, SPH_ERR_UNSTABLE);

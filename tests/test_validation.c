@@ -21,7 +21,7 @@ static sph_status val_advance(sph_world* w, double t_end, double factor) {
         if (!(dt > 0)) return w->status != SPH_OK ? w->status : SPH_ERR_UNSTABLE;
         if (rem <= dt) dt = rem;
         else if (rem < 2 * dt) dt = rem / 2;
-        s = sph_step(w, (sph_real)dt);
+        s = th_step(w, (sph_real)dt);
         if (s != SPH_OK) return s;
     }
     return SPH_OK;
@@ -103,7 +103,7 @@ static void test_dam_break_fixed_dt(void) {
             const double t = scene_mm_time(scene_mm_T[k], d.a);
             double e;
             while (w.time < t - 1e-12 && s == SPH_OK) { /* the last step cut to land on t */
-                s = sph_step(&w, (sph_real)fmin(dt, t - w.time));
+                s = th_step(&w, (sph_real)fmin(dt, t - w.time));
                 ++steps;
             }
             e = (scene_dam_front(&w, &d) - scene_mm_Z[k]) / scene_mm_Z[k];
@@ -144,7 +144,7 @@ static sph_status val_two_layer(sph_density density, double ratio, double* err) 
     psum = (double*)calloc(w.n, sizeof(double));
     cnt = (int*)calloc(w.n, sizeof(int));
     while (w.time < 1.5 && s == SPH_OK) {
-        s = sph_step(&w, sph_stable_dt(&w, SPH_SOLVER_WCSPH));
+        s = th_step(&w, sph_stable_dt(&w, SPH_SOLVER_WCSPH));
         if (s == SPH_OK && w.time >= 1.0)
             for (i = 0; i < w.n; ++i) { psum[w.id[i]] += (double)w.p[i]; cnt[w.id[i]]++; }
     }

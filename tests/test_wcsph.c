@@ -566,7 +566,7 @@ static int run_sliding(double dt, int steps, double* vy_max) {
     *vy_max = 0;
     for (i = 0; i < w.n; ++i) w.v[2 * i] = (sph_real)0.2;
     for (s = 0; s < steps; ++s) {
-        if (sph_step(&w, (sph_real)dt) != SPH_OK) {
+        if (th_step(&w, (sph_real)dt) != SPH_OK) {
             CHECK_EQ_INT(w.status, SPH_ERR_UNSTABLE);
             failed_at = s;
             break;
@@ -694,8 +694,8 @@ static int twins_identical(sph_world_def d1, sph_world_def d2, int steps, int b_
     if (a.n == 0 || b.n == 0) return 0;
     if (b_no_gravity) b.def.gravity[1] = 0;
     for (s = 0; s < steps; ++s) {
-        CHECK_EQ_INT(sph_step(&a, 2e-4), SPH_OK);
-        CHECK_EQ_INT(sph_step(&b, 2e-4), SPH_OK);
+        CHECK_EQ_INT(th_step(&a, 2e-4), SPH_OK);
+        CHECK_EQ_INT(th_step(&b, 2e-4), SPH_OK);
     }
     same = memcmp(a.x, b.x, a.n * 2 * sizeof(sph_real)) == 0 &&
            memcmp(a.v, b.v, a.n * 2 * sizeof(sph_real)) == 0 &&
@@ -750,7 +750,7 @@ static double tg_run(sph_integrator integ, double dt, int steps, sph_real* out) 
         w.v[2 * i + 1] = (sph_real)(sin(2 * pi * x) * cos(2 * pi * y));
     }
     for (s = 0; s < steps; ++s)
-        if (sph_step(&w, (sph_real)dt) != SPH_OK) { CHECK_MSG(0, "step: %s", w.error); break; }
+        if (th_step(&w, (sph_real)dt) != SPH_OK) { CHECK_MSG(0, "step: %s", w.error); break; }
     for (i = 0; i < w.n; ++i) { /* by id, unwrapped relative to a fixed corner */
         out[2 * w.id[i]] = w.x[2 * i];
         out[2 * w.id[i] + 1] = w.x[2 * i + 1];
@@ -844,7 +844,7 @@ static void run_threads(int threads, sph_integrator it, sph_world* w) {
     omp_set_num_threads(threads);
     def.integrator = it;
     if (scene_dam_break(w, def, 0.1, 24, NULL) != SPH_OK) { CHECK_MSG(0, "%s", scene_error); return; }
-    for (s = 0; s < 150; ++s) CHECK_EQ_INT(sph_step(w, 1.5e-4), SPH_OK);
+    for (s = 0; s < 150; ++s) CHECK_EQ_INT(th_step(w, 1.5e-4), SPH_OK);
 }
 #endif
 

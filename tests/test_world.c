@@ -327,24 +327,24 @@ static void test_bad_step_input(void) {
     sph_real keep;
     int ph = small_tank(&w, NULL);
     CHECK(ph >= 0);
-    CHECK_EQ_INT(sph_step(&w, 1e-4), SPH_OK);
+    CHECK_EQ_INT(th_step(&w, 1e-4), SPH_OK);
     snap_take(&s, &w);
-    CHECK_EQ_INT(sph_step(&w, 0), SPH_ERR_ARG);
+    CHECK_EQ_INT(th_step(&w, 0), SPH_ERR_ARG);
     CHECK(strstr(w.error, "dt") != NULL);
-    CHECK_EQ_INT(sph_step(&w, -1e-4), SPH_ERR_ARG);
-    CHECK_EQ_INT(sph_step(&w, (sph_real)NAN), SPH_ERR_ARG);
+    CHECK_EQ_INT(th_step(&w, -1e-4), SPH_ERR_ARG);
+    CHECK_EQ_INT(th_step(&w, (sph_real)NAN), SPH_ERR_ARG);
     CHECK_EQ_INT(sph_advance(&w, -1), SPH_ERR_ARG);
     CHECK(snap_same(&s, &w));
     keep = w.x[2 * 7 + 1];
     w.x[2 * 7 + 1] = (sph_real)NAN;
-    CHECK_EQ_INT(sph_step(&w, 1e-4), SPH_ERR_ARG);
+    CHECK_EQ_INT(th_step(&w, 1e-4), SPH_ERR_ARG);
     CHECK(strstr(w.error, "position") != NULL);
     CHECK_EQ_INT(w.error_index, 7);
     w.x[2 * 7 + 1] = keep;
     CHECK(snap_same(&s, &w));
     keep = w.v[2 * 3];
     w.v[2 * 3] = (sph_real)INFINITY;
-    CHECK_EQ_INT(sph_step(&w, 1e-4), SPH_ERR_ARG);
+    CHECK_EQ_INT(th_step(&w, 1e-4), SPH_ERR_ARG);
     CHECK(strstr(w.error, "velocity") != NULL);
     w.v[2 * 3] = keep;
     CHECK(snap_same(&s, &w));
@@ -354,7 +354,7 @@ static void test_bad_step_input(void) {
     CHECK_EQ_INT(sph_add_boundary(&w, 1, xbad, NULL, 0), SPH_ERR_ARG);
     CHECK_EQ_INT(sph_add_boundary(&w, 1, xok, NULL, -2), SPH_ERR_ARG);
     CHECK(snap_same(&s, &w));
-    CHECK_EQ_INT(sph_step(&w, 1e-4), SPH_OK); /* and it still runs */
+    CHECK_EQ_INT(th_step(&w, 1e-4), SPH_OK); /* and it still runs */
     snap_free(&s);
     sph_world_free(&w);
 }
@@ -372,7 +372,7 @@ static void test_bad_callback_output(void) {
     d.spacing = 0.02;
     d.boundary_motion = nan_motion;
     CHECK(small_tank(&w, &d) >= 0);
-    CHECK_EQ_INT(sph_step(&w, 1e-4), SPH_ERR_ARG);
+    CHECK_EQ_INT(th_step(&w, 1e-4), SPH_ERR_ARG);
     CHECK(strstr(w.error, "boundary motion callback") != NULL);
     sph_world_free(&w);
 }
@@ -393,7 +393,7 @@ static void test_ids_follow_particles(void) {
     m0 = sph_world_mass(&w);
     for (i = 0; i < n; ++i)
         if (w.id[i] == 57) { track[0] = w.x[2 * i]; track[1] = w.x[2 * i + 1]; }
-    for (s = 0; s < 20; ++s) CHECK_EQ_INT(sph_step(&w, 2e-4), SPH_OK);
+    for (s = 0; s < 20; ++s) CHECK_EQ_INT(th_step(&w, 2e-4), SPH_OK);
     CHECK_EQ_INT(w.n, n);
     CHECK(sph_world_mass(&w) == m0);
     seen = (unsigned char*)calloc(n, 1);
@@ -418,7 +418,7 @@ static void test_blowup_detected(void) {
     int step, failed_at = -1;
     double c0, dt;
     CHECK(small_tank(&w, NULL) >= 0);
-    CHECK_EQ_INT(sph_step(&w, 1e-5), SPH_OK);
+    CHECK_EQ_INT(th_step(&w, 1e-5), SPH_OK);
     c0 = (double)w.phases[0].sound_speed;
     dt = 6.5 * 0.25 * (double)w.h / c0;
     for (step = 0; step < 2000; ++step) {
@@ -430,7 +430,7 @@ static void test_blowup_detected(void) {
             if (!(v <= c0) || !((double)w.rho[i] / 1000 - 1 <= 0.2)) clean = 0;
         }
         CHECK(clean);
-        s = sph_step(&w, (sph_real)dt);
+        s = th_step(&w, (sph_real)dt);
         if (s != SPH_OK) {
             long k = w.error_index;
             failed_at = step;
@@ -464,7 +464,7 @@ static void test_write_csv_vtk(void) {
     const char* csv = "build/test_world.csv";
     const char* vtk = "build/test_world.vtk";
     CHECK(small_tank(&w, NULL) >= 0);
-    CHECK_EQ_INT(sph_step(&w, 1e-4), SPH_OK);
+    CHECK_EQ_INT(th_step(&w, 1e-4), SPH_OK);
     CHECK_EQ_INT(sph_write_csv(&w, csv), SPH_OK);
     f = fopen(csv, "r");
     CHECK(f != NULL);
