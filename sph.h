@@ -197,8 +197,8 @@ int main(void) {
    follows from the equation of state; a wall acts on a fluid particle like fluid of that
    particle's own rest density. Free slip (default) leaves walls out of the viscous terms;
    no-slip uses Adami's extrapolated wall velocity. Boundary particles can move: see callbacks.
-   def.boundary_pressure picks how the fluid sees a wall's pressure: extrapolated (default; the
-   only one that fits WCSPH), mirrored (p_b = p_i; dp/dn = 0 at the wall, so hydrostatic
+   def.boundary_pressure picks how the fluid sees a wall's pressure: automatic (default: zero for
+   IISPH and DFSPH, extrapolated for the others), extrapolated (the only one that fits WCSPH), mirrored (p_b = p_i; dp/dn = 0 at the wall, so hydrostatic
    pressure comes out steep) or zero (the wall-adjacent layer carries the load; with WCSPH
    particles get through). def.boundary_volume = SPH_BVOL_AKINCI recomputes each wall particle's
    volume from the wall particles around it whenever walls move (Akinci et al. 2012), for
@@ -644,9 +644,18 @@ typedef enum sph_viscosity_form {
 /* How a fluid particle sees the pressure of a wall particle (Meiers 2025 sec. 4.2). */
 typedef enum sph_boundary_pressure {
     SPH_BP_EXTRAPOLATE = 0, /* Adami et al. 2012: p_b from the fluid with body force and wall
-                               acceleration (default)                                         */
-    SPH_BP_MIRROR,          /* p_b = p_i, rho_b = rho_i (Koschier et al. 2020)                  */
-    SPH_BP_ZERO             /* p_b = 0 (Akinci et al. 2012 as used by Ihmsen et al. 2014)      */
+                               acceleration (WCSPH's and the compressible step's default)      */
+    SPH_BP_MIRROR,          /* p_b = p_i, rho_b = rho_i (Koschier et al. 2020); gains energy
+                               with the incompressible solvers (tests/test_scenes.c)          */
+    SPH_BP_ZERO,            /* p_b = 0 (Akinci et al. 2012 as used by Ihmsen et al. 2014; Bender
+                               & Koschier 2017): IISPH's and DFSPH's default                  */
+    SPH_BP_AUTO             /* (the default of sph_world_def_default) resolved by
+                               sph_world_init from def.solver: ZERO for IISPH and DFSPH, whose
+                               every user scene of tests/test_scenes.c it holds (extrapolated
+                               walls made IISPH's tank at rest slosh at 0.86 sqrt(g H) and
+                               mirrored ones gained energy), EXTRAPOLATE for the others (WCSPH
+                               with zero wall pressure lets particles into the walls). w.def
+                               holds the scheme used                                          */
 } sph_boundary_pressure;
 
 /* Where wall particle volumes come from. */
@@ -756,7 +765,7 @@ typedef struct sph_world_def {
     sph_real beta;             /* Monaghan artificial viscosity beta [-]; default 0; [0, 10]      */
     sph_viscosity_form viscosity_form; /* laminar viscosity operator; default SPH_VISC_MORRIS    */
     sph_wall wall;             /* default SPH_WALL_FREE_SLIP                                      */
-    sph_boundary_pressure boundary_pressure; /* default SPH_BP_EXTRAPOLATE                        */
+    sph_boundary_pressure boundary_pressure; /* default SPH_BP_AUTO (see there)                   */
     sph_boundary_volume boundary_volume;     /* default SPH_BVOL_GIVEN                            */
     sph_real boundary_gamma;   /* Akinci volume factor gamma_1 (Meiers 2025 eq. 27) [-]; default 1;
                                   (0, 10]; used with SPH_BVOL_AKINCI only                        */
@@ -774,10 +783,10 @@ typedef struct sph_world_def {
     sph_real tolerance;        /* stop when the mean predicted compression <= tolerance [-];
                                   default 0.001 (sph_world_def_pcisph: 1e-4); (0, 1)             */
     int min_iterations;        /* default 2 (sph_world_def_pcisph: 3); [0, 100000]               */
-    int max_iterations;        /* default 100; [max(1, min_iterations), 100000]. Reaching it is
-                                  not an error: the step moves with the last pressure; compare
-                                  w.stats.iterations and .solver_error (DFSPH, per solve: it
-                                  returns SPH_ERR_NOT_CONVERGED)                                 */
+    int max_iterations;        /* default 100; [max(1, min_iterations), 100000]. A solve that
+                                  reaches it above its tolerance takes the step with its last
+                                  pressure and returns SPH_ERR_NOT_CONVERGED (sph_advance then
+                                  undoes the step and retries a smaller one)                     */
     sph_real omega;            /* IISPH's relaxed Jacobi weight [-]; default 0.5; (0, 1]          */
     sph_real warm_start;       /* iterative solvers: initial pressure = warm_start * last pressure;
                                   0.5 (sph_world_def_pcisph: 0 for the original, 0.5 enhanced);
@@ -938,6 +947,8 @@ typedef struct sph__private {
     double dt_factor;               /* sph_advance: factor on sph_stable_dt (failed steps shrink it) */
     double a_np_max;                /* PCISPH, IISPH, DFSPH: largest non-pressure acceleration of
                                        the last step [m/s^2] (sph__record_nonpressure)           */
+    int cold_start;                 /* sph_advance's retry: pressure solves start from 0        */
+    double gain_eff;                /* PCISPH: factor on the gain, 1 unless a correction diverged */
     double omega_eff;               /* IISPH: the Jacobi weight in use, def.omega unless a solve
                                        diverged (see sph__jacobi_guard)                          */
     double correct_fraction;        /* PCISPH, IISPH: the fraction of the compression standing at
@@ -1081,8 +1092,12 @@ SPHDEF void sph_world_momentum(const sph_world* w, double* out);
 /* Largest stable time step [s] for the solver from the CFL (acoustic), viscous and force limits.
    Returns 0 and sets w->error if it cannot be determined. The first limit is cfl h / (max c0 +
    |v|max) for WCSPH, cfl h / max(c_i + |v_i|) over fluid particles for the compressible step,
-   cfl_velocity dx / |v|max for IISPH, PCISPH and DFSPH (|v|max over fluid and boundary particles); then
-   the viscous and force limits and def.max_dt (see their fields). Fills in automatic sound
+   for IISPH, PCISPH and DFSPH the velocity limit on the speed reached within the step,
+   (|v|max + |a| dt) dt <= cfl_velocity dx (|v|max over fluid and boundary particles, |a| their
+   largest non-pressure acceleration: a step from rest is limited too); then the viscous and
+   force limits (the incompressible solvers' at 0.4 cfl_force sqrt(h / |a|) with the non-pressure
+   |a|: a pressure that enforces incompressibility grows like 1 / dt, and limiting the step by it
+   feeds back) and def.max_dt (see their fields). Fills in automatic sound
    speeds. Fails (SPH_ERR_ARG) for an unknown solver, when WCSPH or the compressible step lacks a
    sound speed it cannot choose, when WCSPH has no sound speed at all (e.g. no particles yet), or
    when nothing limits the step; SPH_ERR_UNSTABLE when the step rounds to 0 (e.g. |v| near the
@@ -1091,10 +1106,16 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver);
 /* One step of the solver selected in def.solver: sph_step_wcsph, _iisph, _pcisph, _compressible
    or _dfsph. */
 SPHDEF sph_status sph_step(sph_world* w, sph_real dt);
-/* Advances by duration [s] in sub-steps of the stable time step (what a game calls per frame).
-   duration finite and >= 0. Lands exactly on the end: a remainder under two steps is split in
-   halves. Returns the first error (of sph_stable_dt or a step); SPH_ERR_UNSTABLE if the
-   stable step falls below 1e-12 duration. */
+/* Advances by duration [s] in sub-steps of the stable time step (what a game calls per frame);
+   the robust integrator. duration finite and >= 0. Each sub-step is dt_factor * sph_stable_dt,
+   shortened to land exactly on the end (a remainder under two steps is split in halves). A
+   sub-step that fails with SPH_ERR_UNSTABLE (blow-up, runaway speed, a particle moving more than
+   def.max_displacement or inside a wall) or SPH_ERR_NOT_CONVERGED is undone bit for bit and
+   retried at half the step, up to 12 times in a row; dt_factor grows back by 1.1 per successful
+   sub-step and is kept in the world. At most def.max_substeps sub-steps (retries included) per
+   call (SPH_ERR_BUDGET). On any error the world is as it was before the call (its w.error and
+   w.stats.retries tell what happened); on success w.time is exactly the old time + duration.
+   w.stats.substeps, .retries, .dt_min and .dt_factor describe the call. */
 SPHDEF sph_status sph_advance(sph_world* w, sph_real duration);
 
 /* ============================================================================================== */
@@ -2283,7 +2304,7 @@ SPHDEF sph_world_def sph_world_def_default(int dim) {
     d.max_displacement = 1;
     d.check_walls = 1;
     d.max_substeps = 100000;
-    d.boundary_pressure = SPH_BP_EXTRAPOLATE;
+    d.boundary_pressure = SPH_BP_AUTO;
     d.boundary_volume = SPH_BVOL_GIVEN;
     d.boundary_gamma = 1;
     d.cfl_velocity = SPH__R(0.4); /* Meiers 2025 eq. 14 */
@@ -2352,7 +2373,7 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
                    k, (double)d->gravity[k]);
     SPH__CHECK((int)d->solver >= 0 && d->solver <= SPH_SOLVER_DFSPH,
                "sph_world_def.solver = %d: not a sph_solver", (int)d->solver);
-    SPH__CHECK((int)d->boundary_pressure >= 0 && d->boundary_pressure <= SPH_BP_ZERO,
+    SPH__CHECK((int)d->boundary_pressure >= 0 && d->boundary_pressure <= SPH_BP_AUTO,
                "sph_world_def.boundary_pressure = %d: not a sph_boundary_pressure",
                (int)d->boundary_pressure);
     SPH__CHECK((int)d->boundary_volume >= 0 && d->boundary_volume <= SPH_BVOL_AKINCI,
@@ -2496,6 +2517,10 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
     w->priv.solver = (int)def->solver; /* until a step says which solver runs */
     hf = def->h_factor > 0 ? def->h_factor : sph_kernel_default_h_factor(def->kernel);
     w->def.h_factor = hf;
+    if (def->boundary_pressure == SPH_BP_AUTO)
+        w->def.boundary_pressure = def->solver == SPH_SOLVER_IISPH || def->solver == SPH_SOLVER_DFSPH
+                                       ? SPH_BP_ZERO
+                                       : SPH_BP_EXTRAPOLATE;
     w->h = hf * def->spacing;
     s = sph_kernel_init(&w->kernel, def->kernel, def->dim, w->h);
     if (s != SPH_OK) /* the type and dim are valid: h is out of sph_real's reach */
@@ -4428,6 +4453,13 @@ static void sph__record_nonpressure(sph_world* w) {
     w->priv.a_np_max = sqrt(m);
 }
 
+/* The warm start of the pressure solves: def.warm_start times the last pressure, except in a
+   step that sph_advance retries after a failure. The pressure of the failed step's start is part
+   of what failed: a corner particle whose walls extrapolate its own pressure can carry a
+   pressure that, half of it warm-started, blows the retry up at any dt (enhanced PCISPH's dam
+   break failed 13 retries down to dt = 4e-9 s); the retry starts from p = 0. */
+static sph_real sph__warm(const sph_world* w) { return w->priv.cold_start ? 0 : w->def.warm_start; }
+
 /* The end of an iterative solve above its tolerance: the step was taken with the last pressure,
    and the caller hears of it (sph_advance undoes the step and retries a smaller one). */
 static sph_status sph__not_converged(sph_world* w, const char* solver, int it, double err,
@@ -5254,6 +5286,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
     const double S = (summation ? (double)w->priv.lattice_sum : 1.0) * (verlet ? 2.0 : 1.0);
     double t0 = sph__now(), tstart = t0, err = 0, errmax = 0, proto[SPH_MAX_PHASES];
     sph_real keep, shift = 0;
+    double errmax_min = 0;
     int enclosed;
     uint64_t sorts;
     sph__ctx c;
@@ -5303,11 +5336,13 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
     if (c.laminar || c.av) sph__stage_interact(w, &c, SPH__VISCOUS, w->a);
     sph__time(w, SPH_STAGE_FORCES, &t0);
     /* gains */
+    if (!(w->priv.gain_eff > 0) || w->priv.gain_eff > 1) w->priv.gain_eff = 1;
     {
         const double g2 = sph__lattice_grad2(&w->kernel, w->dx);
         for (q = 0; q < w->nphase; ++q) {
             const double m = (double)w->phases[q].mass, r0 = (double)w->phases[q].rest_density;
-            proto[q] = (double)w->def.pcisph_gain * S * r0 * r0 / (2 * (double)dt * (double)dt * m * m * g2);
+            proto[q] = (double)w->def.pcisph_gain * w->priv.gain_eff * S * r0 * r0 /
+                       (2 * (double)dt * (double)dt * m * m * g2);
         }
     }
     SPH__OMP_FOR(w->n)
@@ -5317,14 +5352,14 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
             const sph_real den = D == 2   ? sph__pcisph_denominator(&c, (size_t)i, 2)
                                  : D == 3 ? sph__pcisph_denominator(&c, (size_t)i, 3)
                                           : sph__pcisph_denominator(&c, (size_t)i, 1);
-            f = den > 0 ? (sph_real)((double)w->def.pcisph_gain * S * (double)w->rho[i] /
+            f = den > 0 ? (sph_real)((double)w->def.pcisph_gain * w->priv.gain_eff * S * (double)w->rho[i] /
                                      (2 * (double)dt * (double)dt * (double)den))
                         : 0;
         } else {
             f = (sph_real)proto[w->phase[i]];
         }
         w->priv.aii[i] = f;
-        w->p[i] = w->p[i] > 0 ? w->def.warm_start * w->p[i] : 0; /* Alg. 5: warm_start = 0 */
+        w->p[i] = w->p[i] > 0 ? sph__warm(w) * w->p[i] : 0; /* Alg. 5: warm_start = 0 */
     }
     memset(w->priv.ap, 0, nD * sizeof(sph_real));
     keep = sph__standing_keep(w);
@@ -5388,6 +5423,16 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
             if (w->priv.block[2 * (size_t)blk + 1] > errmax) errmax = w->priv.block[2 * (size_t)blk + 1];
         }
         err = w->n ? err / (double)w->n : 0;
+        /* a correction that overshoots (the gain of a particle whose walls extrapolate its own
+           pressure is too large for it: a corner) grows its largest error; then the gain is cut
+           to 0.7 of itself, as sph__jacobi_guard cuts IISPH's weight */
+        if (it == 0 || errmax < errmax_min) errmax_min = errmax;
+        if (it >= 3 && errmax > 2 * errmax_min && w->priv.gain_eff > 1e-3) {
+            w->priv.gain_eff *= 0.7;
+            errmax_min = errmax;
+            SPH__OMP_FOR(w->n)
+            for (i = 0; i < (sph__idx)w->n; ++i) w->priv.aii[i] *= SPH__R(0.7);
+        }
         {
             sph__ctx cq = c; /* pressure positions: predicted with summation density */
             if (summation) cq.x = w->priv.xp;
@@ -5401,6 +5446,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
             it >= w->def.max_iterations)
             break;
     }
+    if (err <= (double)w->def.tolerance) w->priv.gain_eff = fmin(1.0, 1.02 * w->priv.gain_eff);
     sph__time(w, SPH_STAGE_PRESSURE, &t0);
     sph__record_nonpressure(w);
     /* the motion uses the last pressure; with continuity the density follows the new velocity */
@@ -5650,7 +5696,7 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
         if (c.dim == 2) sph__iisph_prepare_one(w, &c, (size_t)i, 2, dt);
         else if (c.dim == 3) sph__iisph_prepare_one(w, &c, (size_t)i, 3, dt);
         else sph__iisph_prepare_one(w, &c, (size_t)i, 1, dt);
-        w->p[i] = w->p[i] > 0 ? w->def.warm_start * w->p[i] : 0;
+        w->p[i] = w->p[i] > 0 ? sph__warm(w) * w->p[i] : 0;
     }
     sph__enclosed_projection(w, w->priv.src);
     /* relaxed Jacobi on the pressure */
@@ -5959,7 +6005,7 @@ static sph_status sph__step_dfsph(sph_world* w, sph_real dt) {
     /* divergence-free solve on v^n (Alg. 3), warm started from the rate kept in w->drho */
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) {
-        const sph_real k0 = w->drho[i] > 0 ? w->def.warm_start * w->drho[i] : 0;
+        const sph_real k0 = w->drho[i] > 0 ? sph__warm(w) * w->drho[i] : 0;
         w->priv.df_kv[i] = k0;
         w->priv.df_pv[i] = w->rho[i] * w->priv.df_alpha_v[i] * k0 / dt;
     }
@@ -5977,7 +6023,7 @@ static sph_status sph__step_dfsph(sph_world* w, sph_real dt) {
     sph__time(w, SPH_STAGE_FORCES, &t0);
     /* constant-density solve on rho* (Alg. 2), warm started from the last pressure */
     SPH__OMP_FOR(w->n)
-    for (i = 0; i < (sph__idx)w->n; ++i) w->p[i] = w->p[i] > 0 ? w->def.warm_start * w->p[i] : 0;
+    for (i = 0; i < (sph__idx)w->n; ++i) w->p[i] = w->p[i] > 0 ? sph__warm(w) * w->p[i] : 0;
     it = sph__dfsph_solve(w, &c, w->priv.df_vs, dt, 1, w->def.min_iterations, tol, &err);
     sph__record_nonpressure(w);
     SPH__OMP_FOR(w->n)
@@ -6352,8 +6398,10 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
         }
         ++substeps;
         w->priv.correct_fraction = fmin(1.0, dt / dt_stable);
+        w->priv.cold_start = in_row > 0;
         s = sph_step(w, (sph_real)dt);
         w->priv.correct_fraction = 1;
+        w->priv.cold_start = 0;
         if (s == SPH_OK) {
             if (dt_min == 0 || dt < dt_min) dt_min = dt;
             in_row = 0;
