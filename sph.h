@@ -811,10 +811,10 @@ typedef struct sph_world_def {
     sph_real max_compression;  /* blow-up if rho/rho0 - 1 exceeds it [-]; default 0.2; 0 = no
                                   check; >= 0; not applied to gas phases                         */
     sph_real max_speed;        /* blow-up if |v| exceeds it [m/s]; 0 (default) = the largest c0
-                                  (WCSPH), 10 c0 (compressible step); for PCISPH and IISPH
-                                  3 sqrt(2 |g| L) + 2 |v_wall|max + 3 |v|max at the step's start,
-                                  L the height of fluid and walls along gravity (a runaway, not
-                                  a fast flow); no check while neither is set; >= 0              */
+                                  (WCSPH), 10 c0 (compressible step), 0.5 c0 + 2 |v_wall|max for
+                                  PCISPH, IISPH and DFSPH (five times the free-fall speed over
+                                  the fluid's height with the automatic c0: a runaway, not a
+                                  fast flow); no check while no c0 is set; >= 0                  */
     sph_real max_displacement; /* blow-up if a fluid particle moves more than this many spacings
                                   dx in one step [-] (a large step through a thin wall, or a
                                   runaway); default 1; 0 = no check; >= 0                        */
@@ -884,7 +884,14 @@ typedef struct sph_stats {
     double dt_min;            /* smallest sub-step that succeeded [s] (0 if none)                  */
     double dt_factor;         /* the step control's factor on sph_stable_dt after the call [-]: 1
                                  unless failed steps made it smaller; it grows back by 1.1 per
-                                 successful sub-step                                             */
+                                 successful sub-step (kept here, so saved with the world)        */
+    /* solver state kept between steps (here, so that a saved world restarts bit for bit): */
+    double a_np_max;          /* PCISPH, IISPH, DFSPH: largest non-pressure acceleration of the
+                                 step [m/s^2], which their force limit reads                     */
+    double omega;             /* IISPH, DFSPH: the Jacobi weight in use, def.omega unless a solve
+                                 diverged (it then shrinks by 0.7 and grows back by 2 % per
+                                 converged solve)                                                */
+    double gain_factor;       /* PCISPH: factor on the gain, 1 unless a correction diverged      */
     int iterations_divergence; /* DFSPH: the divergence-free solve's share of iterations (the
                                  constant-density solve's is iterations minus this); 0 for the
                                  other solvers                                                  */
@@ -939,18 +946,13 @@ typedef struct sph__private {
     int b_dirty;                    /* boundary particles changed since the last boundary grid     */
     int have_mass;                  /* w->mass is set                                               */
     sph_real lattice_sum;           /* dx^dim sum_j W(x_j) over a square lattice of spacing dx     */
+    size_t full_count;              /* neighbours of a particle inside a full square lattice      */
     sph_real wall_fraction_max;     /* check_walls: wall volume fraction of a particle on the
                                        first layer of a flat lattice wall                          */
     uint8_t* snap[2];               /* sph_advance: the state at the call's start [0] and at the
                                        current sub-step's start [1] (rollback)                      */
     size_t snap_cap[2];             /* bytes                                                        */
-    double dt_factor;               /* sph_advance: factor on sph_stable_dt (failed steps shrink it) */
-    double a_np_max;                /* PCISPH, IISPH, DFSPH: largest non-pressure acceleration of
-                                       the last step [m/s^2] (sph__record_nonpressure)           */
     int cold_start;                 /* sph_advance's retry: pressure solves start from 0        */
-    double gain_eff;                /* PCISPH: factor on the gain, 1 unless a correction diverged */
-    double omega_eff;               /* IISPH: the Jacobi weight in use, def.omega unless a solve
-                                       diverged (see sph__jacobi_guard)                          */
     double correct_fraction;        /* PCISPH, IISPH: the fraction of the compression standing at
                                        the step's start that the step corrects, dt / dt_rule when
                                        sph_advance shortened the step below the rule, else 1    */
@@ -2529,6 +2531,17 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
                          "not finite and > 0 in sph_real", (double)def->spacing, (double)w->h);
     w->priv.lattice_sum = sph__lattice_sum(&w->kernel, w->dx);
     w->priv.wall_fraction_max = sph__wall_fraction_limit(&w->kernel, w->dx) / w->priv.lattice_sum;
+    {
+        const int R = (int)(w->kernel.radius / w->dx) + 1, D = def->dim;
+        int i, j, l;
+        w->priv.full_count = 0;
+        for (i = -R; i <= R; ++i)
+            for (j = (D > 1 ? -R : 0); j <= (D > 1 ? R : 0); ++j)
+                for (l = (D > 2 ? -R : 0); l <= (D > 2 ? R : 0); ++l)
+                    if ((i || j || l) &&
+                        w->dx * sph__sqrt((sph_real)(i * i + j * j + l * l)) < w->kernel.radius)
+                        ++w->priv.full_count;
+    }
     for (k = 0; k < def->dim; ++k) {
         per[k] = def->periodic[k] != 0;
         lo[k] = def->domain_lo[k];
@@ -4173,8 +4186,8 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
            only a runaway is a blow-up */
         if (w->priv.solver == SPH_SOLVER_COMPRESSIBLE) vlim *= 10;
         /* the incompressible solvers have no sound speed that bounds the flow: the automatic c0
-           is 10 max(sqrt(2 |g| H), |v|max), so 0.3 c0 is three times the free-fall speed over the
-           fluid's height; walls move the fluid at up to twice their speed (a piston's reflected
+           is 10 max(sqrt(2 |g| H), |v|max), so 0.5 c0 is five times the free-fall speed over the
+           fluid's height (a dam break's splash reached 2.3 times it); walls move the fluid at up to twice their speed (a piston's reflected
            wave), which is added */
         if (sph__incompressible(w->priv.solver) && vlim > 0) {
             double vb2 = 0;
@@ -4184,7 +4197,7 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 for (k = 0; k < D; ++k) v2 += (double)w->b_v[b + (size_t)k] * (double)w->b_v[b + (size_t)k];
                 if (v2 > vb2) vb2 = v2;
             }
-            vlim = (sph_real)(0.3 * (double)vlim + 2 * sqrt(vb2));
+            vlim = (sph_real)(0.5 * (double)vlim + 2 * sqrt(vb2));
         }
     }
     if (nblk * SPH__RED_N > w->priv.block_cap) {
@@ -4375,7 +4388,9 @@ static sph_real sph__standing_keep(const sph_world* w) {
    fluid gains energy until it blows up. The compatibility condition of the discrete problem is
    sum_i s_i = 0 (the constant being the null vector); when no free surface anchors the pressure
    level -- fewer than 0.2 n^((d-1)/d) particles (a fifth of one lattice face of the fluid) have
-   a summation density below 0.9 rho0; a few particles in a vortex's core do not anchor it, the
+   fewer than 0.85 of a full lattice neighbourhood of fluid and wall particles (not a density
+   test: the incompressible solvers compress a free surface's top layer to rho0 as it settles,
+   and a vortex's core thins out); a few particles in a vortex's core do not anchor it, the
    Jacobi sweeps would take thousands of iterations to lift the level through them -- the mean of
    the source is removed, and the solve controls the density differences, which a fixed volume of
    fluid can satisfy. The uniform part, a summation-density bias of the disordered lattice, is
@@ -4384,10 +4399,11 @@ static sph_real sph__standing_keep(const sph_world* w) {
 static int sph__enclosed(const sph_world* w) {
     const double D = (double)w->dim;
     const double anchor = fmax(1.0, 0.2 * pow((double)w->n, (D - 1) / D));
+    const double need = 0.85 * (double)w->priv.full_count;
     size_t i, surface = 0;
     if (w->def.boundary_pressure == SPH_BP_ZERO || w->nb == 0 || w->n == 0) return 0;
     for (i = 0; i < w->n; ++i)
-        surface += w->rho[i] < SPH__R(0.9) * w->phases[w->phase[i]].rest_density;
+        surface += (double)w->priv.ff.count[i] + (double)w->priv.fb.count[i] < need;
     return (double)surface < anchor;
 }
 
@@ -4407,9 +4423,12 @@ static void sph__enclosed_projection(sph_world* w, sph_real* src) {
    sweeps), the weight is cut to 0.7 of itself for the rest of the solve and the steps that
    follow, and grows back by 2 % per converged solve up to def.omega. */
 static void sph__jacobi_guard(sph_world* w, int it, double err, double* err_min) {
+#ifdef SPH_NO_GUARD
+    (void)w; (void)it; (void)err; (void)err_min; return;
+#endif
     if (it == 1 || err < *err_min) *err_min = err;
-    if (it >= 4 && err > 2 * *err_min && w->priv.omega_eff > 1e-3 * (double)w->def.omega) {
-        w->priv.omega_eff *= 0.7;
+    if (it >= 4 && err > 2 * *err_min && w->stats.omega > 1e-3 * (double)w->def.omega) {
+        w->stats.omega *= 0.7;
         *err_min = err;
     }
 }
@@ -4418,21 +4437,24 @@ static void sph__jacobi_guard(sph_world* w, int it, double err, double* err_min)
    corner, whose extrapolated walls make its true diagonal up to 1.65 times the one used) long
    before the mean does. */
 static void sph__jacobi_guard2(sph_world* w, int it, double err, double errmax, double* m) {
+#ifdef SPH_NO_GUARD
+    (void)w; (void)it; (void)err; (void)errmax; (void)m; return;
+#endif
     sph__jacobi_guard(w, it, err, &m[0]);
     if (it == 1 || errmax < m[1]) m[1] = errmax;
-    if (it >= 4 && errmax > 2 * m[1] && w->priv.omega_eff > 1e-3 * (double)w->def.omega) {
-        w->priv.omega_eff *= 0.7;
+    if (it >= 4 && errmax > 2 * m[1] && w->stats.omega > 1e-3 * (double)w->def.omega) {
+        w->stats.omega *= 0.7;
         m[1] = errmax;
     }
 }
 
 static void sph__jacobi_begin(sph_world* w) {
-    if (!(w->priv.omega_eff > 0) || w->priv.omega_eff > (double)w->def.omega)
-        w->priv.omega_eff = (double)w->def.omega;
+    if (!(w->stats.omega > 0) || w->stats.omega > (double)w->def.omega)
+        w->stats.omega = (double)w->def.omega;
 }
 
 static void sph__jacobi_end(sph_world* w, int converged) {
-    if (converged) w->priv.omega_eff = fmin((double)w->def.omega, 1.02 * w->priv.omega_eff);
+    if (converged) w->stats.omega = fmin((double)w->def.omega, 1.02 * w->stats.omega);
 }
 
 /* The largest non-pressure acceleration |g + user forces + viscosity| of the step (w->a before
@@ -4450,7 +4472,7 @@ static void sph__record_nonpressure(sph_world* w) {
         for (k = 0; k < D; ++k) a2 += (double)w->a[i * D + k] * (double)w->a[i * D + k];
         if (a2 > m) m = a2;
     }
-    w->priv.a_np_max = sqrt(m);
+    w->stats.a_np_max = sqrt(m);
 }
 
 /* The warm start of the pressure solves: def.warm_start times the last pressure, except in a
@@ -5336,12 +5358,12 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
     if (c.laminar || c.av) sph__stage_interact(w, &c, SPH__VISCOUS, w->a);
     sph__time(w, SPH_STAGE_FORCES, &t0);
     /* gains */
-    if (!(w->priv.gain_eff > 0) || w->priv.gain_eff > 1) w->priv.gain_eff = 1;
+    if (!(w->stats.gain_factor > 0) || w->stats.gain_factor > 1) w->stats.gain_factor = 1;
     {
         const double g2 = sph__lattice_grad2(&w->kernel, w->dx);
         for (q = 0; q < w->nphase; ++q) {
             const double m = (double)w->phases[q].mass, r0 = (double)w->phases[q].rest_density;
-            proto[q] = (double)w->def.pcisph_gain * w->priv.gain_eff * S * r0 * r0 /
+            proto[q] = (double)w->def.pcisph_gain * w->stats.gain_factor * S * r0 * r0 /
                        (2 * (double)dt * (double)dt * m * m * g2);
         }
     }
@@ -5352,7 +5374,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
             const sph_real den = D == 2   ? sph__pcisph_denominator(&c, (size_t)i, 2)
                                  : D == 3 ? sph__pcisph_denominator(&c, (size_t)i, 3)
                                           : sph__pcisph_denominator(&c, (size_t)i, 1);
-            f = den > 0 ? (sph_real)((double)w->def.pcisph_gain * w->priv.gain_eff * S * (double)w->rho[i] /
+            f = den > 0 ? (sph_real)((double)w->def.pcisph_gain * w->stats.gain_factor * S * (double)w->rho[i] /
                                      (2 * (double)dt * (double)dt * (double)den))
                         : 0;
         } else {
@@ -5427,8 +5449,8 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
            pressure is too large for it: a corner) grows its largest error; then the gain is cut
            to 0.7 of itself, as sph__jacobi_guard cuts IISPH's weight */
         if (it == 0 || errmax < errmax_min) errmax_min = errmax;
-        if (it >= 3 && errmax > 2 * errmax_min && w->priv.gain_eff > 1e-3) {
-            w->priv.gain_eff *= 0.7;
+        if (it >= 3 && errmax > 2 * errmax_min && w->stats.gain_factor > 1e-3) {
+            w->stats.gain_factor *= 0.7;
             errmax_min = errmax;
             SPH__OMP_FOR(w->n)
             for (i = 0; i < (sph__idx)w->n; ++i) w->priv.aii[i] *= SPH__R(0.7);
@@ -5446,7 +5468,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
             it >= w->def.max_iterations)
             break;
     }
-    if (err <= (double)w->def.tolerance) w->priv.gain_eff = fmin(1.0, 1.02 * w->priv.gain_eff);
+    if (err <= (double)w->def.tolerance) w->stats.gain_factor = fmin(1.0, 1.02 * w->stats.gain_factor);
     sph__time(w, SPH_STAGE_PRESSURE, &t0);
     sph__record_nonpressure(w);
     /* the motion uses the last pressure; with continuity the density follows the new velocity */
@@ -5612,7 +5634,7 @@ SPH__INLINE double sph__iisph_update_one(sph_world* w, const sph__ctx* c, size_t
    count). */
 static double sph__iisph_sweep(sph_world* w, const sph__ctx* c, sph_real dt, double* emax) {
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
-    const sph_real omega = (sph_real)w->priv.omega_eff;
+    const sph_real omega = (sph_real)w->stats.omega;
     double sum = 0;
     sph__idx blk;
     size_t q;
@@ -5925,7 +5947,7 @@ static double sph__dfsph_error(sph_world* w, const sph__ctx* c, sph_real dt, int
 /* The stiffness update of the error in w->drho: p_i += rho_i alpha_i (rho*_i - rho0_i)/dt^2
    (constant density), or K_i += D rho_i/Dt and p^v_i = rho_i alpha_i K_i / dt (divergence). */
 static void sph__dfsph_update(sph_world* w, sph_real dt, int density) {
-    const sph_real omega = (sph_real)w->priv.omega_eff;
+    const sph_real omega = (sph_real)w->stats.omega;
     sph__idx i;
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) {
@@ -6165,7 +6187,7 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
        the first step, or sph_advance over an empty world would find nothing limiting its second
        sub-step and fail with SPH_ERR_ARG after the first had changed the world */
     amax = w->steps > 0 && w->n > 0
-               ? (sph__incompressible((int)solver) && w->priv.a_np_max > 0 ? w->priv.a_np_max
+               ? (sph__incompressible((int)solver) && w->stats.a_np_max > 0 ? w->stats.a_np_max
                                                                              : w->stats.a_max)
                : sqrt(g2);
     if (solver == SPH_SOLVER_WCSPH) {
@@ -6244,7 +6266,7 @@ SPHDEF sph_status sph_step(sph_world* w, sph_real dt) {
    the walls (a motion callback, walls not yet sorted), every persistent wall array; the time,
    step count, diagnostics and the sort state. Scratch is recomputed by every step. */
 typedef struct sph__snap_head {
-    double time, a_np_max;
+    double time;
     uint64_t steps, sorts;
     sph_stats stats;
     int b_dirty, walls;
@@ -6287,7 +6309,6 @@ static sph_status sph__snapshot_take(sph_world* w, int slot) {
         w->priv.snap_cap[slot] = bytes;
     }
     head.time = w->time;
-    head.a_np_max = w->priv.a_np_max;
     head.steps = w->steps;
     head.sorts = w->priv.sorts;
     head.stats = w->stats;
@@ -6321,7 +6342,6 @@ static void sph__snapshot_restore(sph_world* w, int slot) {
         pos += sz;
     }
     w->time = head.time;
-    w->priv.a_np_max = head.a_np_max;
     w->steps = head.steps;
     w->priv.sorts = head.sorts;
     w->stats = head.stats;
@@ -6353,7 +6373,7 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
                          (double)duration);
     t_end = w->time + (double)duration;
     if (!(t_end > w->time)) return SPH_OK; /* nothing to do at the resolution of w.time */
-    if (!(w->priv.dt_factor > 0) || w->priv.dt_factor > 1) w->priv.dt_factor = 1;
+    if (!(w->stats.dt_factor > 0) || w->stats.dt_factor > 1) w->stats.dt_factor = 1;
     s = sph__snapshot_take(w, 0);
     if (s != SPH_OK) return s;
     while (w->time < t_end) {
@@ -6379,7 +6399,7 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
             sph__snapshot_restore(w, 0);
             return sph__fail(w, s, -1, "sph_advance: no stable step at t = %g s: %s", w->time, msg);
         }
-        dt = dt_stable * w->priv.dt_factor;
+        dt = dt_stable * w->stats.dt_factor;
         if (remaining <= dt) { dt = remaining; last = 1; }
         else if (remaining < 2 * dt) dt = 0.5 * remaining; /* no sliver of a last step */
         if (!(w->time + dt > w->time) || !((sph_real)dt > 0)) {
@@ -6405,7 +6425,7 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
         if (s == SPH_OK) {
             if (dt_min == 0 || dt < dt_min) dt_min = dt;
             in_row = 0;
-            w->priv.dt_factor = fmin(1.0, 1.1 * w->priv.dt_factor);
+            w->stats.dt_factor = fmin(1.0, 1.1 * w->stats.dt_factor);
             /* land exactly on the end: a float step, or time + dt rounded, may leave a residue
                that a sliver step would make the incompressible solvers treat as a real step */
             if (last) w->time = t_end;
@@ -6415,19 +6435,20 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
             sph__snapshot_restore(w, substeps > 1 ? 1 : 0);
             ++retries;
             ++in_row;
-            w->priv.dt_factor = 0.5 * fmin(w->priv.dt_factor, dt / dt_stable);
+            w->stats.dt_factor = 0.5 * fmin(w->stats.dt_factor, dt / dt_stable);
             continue;
         }
         {
             char msg[SPH_ERROR_SIZE];
             const long idx = w->error_index;
+            const double factor = 0.5 * fmin(w->stats.dt_factor, dt / dt_stable);
             double t;
             memcpy(msg, w->error, sizeof msg);
             sph__snapshot_restore(w, 0);
             w->stats.substeps = substeps;
             w->stats.retries = retries;
             w->stats.dt_min = dt_min;
-            w->stats.dt_factor = w->priv.dt_factor;
+            w->stats.dt_factor = factor; /* the next call starts from the step that failed, halved */
             t = w->time;
             if (s == SPH_ERR_UNSTABLE || s == SPH_ERR_NOT_CONVERGED)
                 return sph__fail(w, s, idx,
@@ -6444,7 +6465,6 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
     w->stats.substeps = substeps;
     w->stats.retries = retries;
     w->stats.dt_min = dt_min;
-    w->stats.dt_factor = w->priv.dt_factor;
     return SPH_OK;
 }
 
