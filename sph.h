@@ -905,8 +905,10 @@ SPHDEF sph_status sph_add_fluid_ex(sph_world* w, int phase, size_t n, const sph_
    layers to cover the kernel support). open_faces: SPH_FACE_* bits of faces left open. Body 0.
    Layers lie outside the box, dx apart across a face (the first half a spacing out) and along it
    at sph_fill_box's spacing; each particle's volume is its cell's. layers in [0, 64] and
-   open_faces <= 63, a box as for sph_fill_box, else SPH_ERR_ARG; SPH_ERR_CAPACITY when the box
-   with its layers spans more than 2^32 - 2 lattice points (they are enumerated). */
+   open_faces <= 63, a box as for sph_fill_box, else SPH_ERR_ARG; SPH_ERR_CAPACITY for a box
+   more than 1e7 spacings long or when its wall particles would take the world past 2^32 - 2
+   boundary particles. Only the wall shell is enumerated: time and memory grow with the number
+   of wall particles, not with the box's volume. */
 SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_real* hi,
                                    int layers, unsigned open_faces);
 /* Adds n boundary particles at x with volumes vol [m^dim] (NULL = dx^dim) and a body tag in
@@ -2749,13 +2751,19 @@ SPHDEF sph_status sph_add_boundary(sph_world* w, size_t n, const sph_real* x, co
 SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_real* hi,
                                    int layers, unsigned open_faces) {
     /* Per direction: `layers` wall coordinates below lo, the interior at a spacing that divides
-       hi - lo exactly (closest to dx), `layers` above hi. A point is a wall point if it lies
-       outside the box in some direction, unless it lies beyond an open face. */
+       hi - lo exactly (closest to dx), `layers` above hi. A lattice point is a wall point if it
+       lies outside the box in some direction, unless it lies beyond an open face. Only the wall
+       shell is visited, in the lattice order (x fastest, then y, then z): a row along x whose y
+       and z lie inside the box holds wall points only in its x layers, so the work and memory
+       grow with the surface, not the volume (a 4 m cube at dx = 0.01, 2.9 M wall particles: the
+       whole-lattice walk took 3.0 s and allocated 2.1 GB for its 67 M lattice points; the shell
+       walk 0.1 s and 94 MB). */
     const int dim = w ? w->dim : 0;
     sph_real* coord[3] = {NULL, NULL, NULL};
     sph_real* width[3] = {NULL, NULL, NULL};
     int* side[3] = {NULL, NULL, NULL};
-    size_t cnt[3] = {1, 1, 1}, total = 1, i, nw = 0;
+    size_t cnt[3] = {1, 1, 1}, nw = 0, iy, iz;
+    double all = 1, inner = 1; /* lattice points not beyond an open face; of them inside the box */
     sph_real *pts = NULL, *vol = NULL;
     sph_status s;
     int k;
@@ -2769,17 +2777,24 @@ SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_r
         return sph__fail(w, SPH_ERR_ARG, -1, "sph_add_wall_box: open_faces = %u: not SPH_FACE_* bits",
                          open_faces);
     if (layers == 0) layers = (int)ceil((double)(w->kernel.radius / w->dx) - 1e-9);
-    for (k = 0; k < dim; ++k) {
-        double span = (double)((hi[k] - lo[k]) / w->dx);
-        size_t ni, j, c = 0;
-        sph_real sp;
+    for (k = 0; k < dim; ++k) { /* the wall count first, before anything is allocated */
+        double span = (double)((hi[k] - lo[k]) / w->dx), ni;
         /* before the conversion: a span beyond size_t (or hi - lo overflowing to inf) would make
            it undefined */
-        if (!(span <= 1e7)) {
-            s = sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_add_wall_box: box too large");
-            goto done;
-        }
-        ni = (size_t)(span + 0.5);
+        if (!(span <= 1e7)) return sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_add_wall_box: box too large");
+        ni = floor(span + 0.5);
+        if (ni < 1) ni = 1;
+        inner *= ni;
+        all *= ni + (open_faces & (1u << (2 * k)) ? 0 : layers) +
+               (open_faces & (1u << (2 * k + 1)) ? 0 : layers);
+    }
+    if (all - inner + (double)w->nb > (double)UINT32_MAX - 1)
+        return sph__fail(w, SPH_ERR_CAPACITY, -1,
+                         "sph_add_wall_box: %.0f wall particles (with the %zu there) exceed the "
+                         "limit of %u", all - inner, w->nb, (unsigned)(UINT32_MAX - 1));
+    for (k = 0; k < dim; ++k) {
+        size_t ni = (size_t)((double)((hi[k] - lo[k]) / w->dx) + 0.5), j, c = 0;
+        sph_real sp;
         if (ni < 1) ni = 1;
         sp = (hi[k] - lo[k]) / (sph_real)ni;
         cnt[k] = ni + 2 * (size_t)layers;
@@ -2790,7 +2805,8 @@ SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_r
         for (j = (size_t)layers; j > 0; --j, ++c) {
             coord[k][c] = lo[k] - ((sph_real)(j - 1) + SPH__R(0.5)) * w->dx;
             width[k][c] = w->dx;
-            side[k][c] = -1;
+            /* -2, 2: a layer beyond an open face (never a wall point); -1, 1: a wall layer */
+            side[k][c] = open_faces & (1u << (2 * k)) ? -2 : -1;
         }
         for (j = 0; j < ni; ++j, ++c) {
             coord[k][c] = lo[k] + ((sph_real)j + SPH__R(0.5)) * sp;
@@ -2800,37 +2816,46 @@ SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_r
         for (j = 0; j < (size_t)layers; ++j, ++c) {
             coord[k][c] = hi[k] + ((sph_real)j + SPH__R(0.5)) * w->dx;
             width[k][c] = w->dx;
-            side[k][c] = 1;
+            side[k][c] = open_faces & (1u << (2 * k + 1)) ? 2 : 1;
         }
-        /* the points are picked from the whole lattice of box and layers, which is allocated:
-           past the particle limit it would overflow size_t or ask for terabytes */
-        if (cnt[k] > ((size_t)UINT32_MAX - 1) / total) {
-            s = sph__fail(w, SPH_ERR_CAPACITY, -1,
-                          "sph_add_wall_box: box too large (its lattice exceeds %u points)",
-                          (unsigned)(UINT32_MAX - 1));
-            goto done;
-        }
-        total *= cnt[k];
     }
-    pts = (sph_real*)SPH_MALLOC(total * (size_t)dim * sizeof(sph_real));
-    vol = (sph_real*)SPH_MALLOC(total * sizeof(sph_real));
+    nw = (size_t)(all - inner);
+    if (nw == 0) goto done; /* no layer (a support below 1e-9 dx) or every face open */
+    pts = (sph_real*)SPH_MALLOC(nw * (size_t)dim * sizeof(sph_real));
+    vol = (sph_real*)SPH_MALLOC(nw * sizeof(sph_real));
     if (!pts || !vol) { s = SPH_ERR_NOMEM; goto done; }
-    for (i = 0; i < total; ++i) {
-        size_t r = i, ix[3] = {0, 0, 0};
-        int outside = 0, open = 0;
-        sph_real V = 1;
-        for (k = 0; k < dim; ++k) { ix[k] = r % cnt[k]; r /= cnt[k]; }
-        for (k = 0; k < dim; ++k) {
-            int sd = side[k][ix[k]];
-            if (sd != 0) outside = 1;
-            if (sd < 0 && (open_faces & (1u << (2 * k)))) open = 1;
-            if (sd > 0 && (open_faces & (1u << (2 * k + 1)))) open = 1;
-            V *= width[k][ix[k]];
+    nw = 0;
+    for (iz = 0; iz < cnt[2]; ++iz) {
+        const int sz = dim > 2 ? side[2][iz] : 0;
+        if (sz == -2 || sz == 2) continue;
+        for (iy = 0; iy < cnt[1]; ++iy) {
+            const int sy = dim > 1 ? side[1][iy] : 0, inside = sy == 0 && sz == 0;
+            size_t ix;
+            if (sy == -2 || sy == 2) continue;
+            /* a row inside the box in y and z has wall points only in its x layers; with both x
+               faces open it has none, and neither have the rows after it up to the high y
+               layers */
+            if (inside && side[0][0] == -2 && side[0][cnt[0] - 1] == 2) {
+                if (dim > 1) iy = cnt[1] - (size_t)layers - 1;
+                continue;
+            }
+            for (ix = 0; ix < cnt[0]; ++ix) {
+                size_t at[3];
+                sph_real V = 1;
+                if (inside && ix == (size_t)layers) ix = cnt[0] - (size_t)layers; /* the box */
+                if (side[0][ix] == -2 || side[0][ix] == 2) continue;
+                at[0] = ix;
+                at[1] = iy;
+                at[2] = iz;
+                for (k = 0; k < dim; ++k) { /* V multiplied in the order of the lattice walk */
+                    pts[nw * (size_t)dim + (size_t)k] = coord[k][at[k]];
+                    V *= width[k][at[k]];
+                }
+                vol[nw++] = V;
+            }
         }
-        if (!outside || open) continue;
-        for (k = 0; k < dim; ++k) pts[nw * (size_t)dim + (size_t)k] = coord[k][ix[k]];
-        vol[nw++] = V;
     }
+    SPH_ASSERT(nw == (size_t)(all - inner));
     s = sph__append_boundary(w, nw, pts, vol, 0);
 done:
     if (s == SPH_ERR_NOMEM) sph__fail(w, s, -1, "sph_add_wall_box: out of memory");
