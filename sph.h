@@ -2755,9 +2755,9 @@ SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_r
        lies outside the box in some direction, unless it lies beyond an open face. Only the wall
        shell is visited, in the lattice order (x fastest, then y, then z): a row along x whose y
        and z lie inside the box holds wall points only in its x layers, so the work and memory
-       grow with the surface, not the volume (a 4 m cube at dx = 0.01, 2.9 M wall particles: the
-       whole-lattice walk took 3.0 s and allocated 2.1 GB for its 67 M lattice points; the shell
-       walk 0.1 s and 94 MB). */
+       grow with the surface, not the volume (a 4 m cube at dx = 0.01, 2.9 M wall particles: with
+       the whole-lattice walk the call allocated 2.1 GB of scratch for 67 M lattice points and
+       took 3.0 s; with the shell walk 94 MB and 1.9 s, most of it filling the world's arrays). */
     const int dim = w ? w->dim : 0;
     sph_real* coord[3] = {NULL, NULL, NULL};
     sph_real* width[3] = {NULL, NULL, NULL};
