@@ -2167,6 +2167,42 @@ SPHDEF void sph_world_def_pcisph(sph_world_def* def, int enhanced) {
     }
 }
 
+/* Coordinates far from the origin leave the spacing under-resolved: x carries |x| eps(sph_real)
+   of rounding [m], and the fluid feels that noise as a disordered lattice. Measured with a 2D
+   float tank at rest (600 particles, dx = 0.01 to 0.02 m, 1 s of WCSPH, tests/test_hostile.c):
+   no particle left its walls while the rounding step ulp(x) <= 0.0015 dx (x up to 510 m at
+   dx = 0.02), 2 of 600 did at ulp = 0.002 dx, 4 to 10 at 0.003 dx, 308 at x = 1e4 m (0.06 dx).
+   Since ulp(x) <= |x| eps, |x| eps <= dx / 1000 keeps a margin of 1.5 below the last clean
+   measurement: |x| <= 168 m at dx = 0.02 in float, 9e10 m in double. */
+#define SPH__FAR_FRACTION 1000.0
+#ifdef SPH_FLOAT
+#define SPH__EPS 1.1920928955078125e-07 /* FLT_EPSILON */
+#else
+#define SPH__EPS 2.220446049250313e-16 /* DBL_EPSILON */
+#endif
+
+/* The largest |coordinate| [m] a world of spacing dx accepts. */
+static double sph__far_limit(sph_real dx) { return (double)dx / (SPH__FAR_FRACTION * SPH__EPS); }
+
+/* Index of the first of count coordinates beyond the limit, or count if none. */
+static size_t sph__first_far(const sph_real* x, size_t count, double limit) {
+    size_t i;
+    for (i = 0; i < count; ++i)
+        if (fabs((double)x[i]) > limit) return i;
+    return count;
+}
+
+/* The message for a coordinate beyond the limit; what names the caller and the particle. */
+static sph_status sph__fail_far(sph_world* w, sph_real dx, long index, const char* what,
+                                double value) {
+    return sph__fail(w, SPH_ERR_ARG, index,
+                     "%s = %g m: too far from the origin for dx = %g m in %s (|x| must be <= "
+                     "%.3g m, |x| eps <= dx/1000): place the scene near the origin%s",
+                     what, value, (double)dx, sizeof(sph_real) == 4 ? "float" : "double",
+                     sph__far_limit(dx),
+                     sizeof(sph_real) == 4 ? " or build in double (without SPH_FLOAT)" : "");
+}
+
 /* Each check names the field and the value it rejects. */
 #define SPH__CHECK(cond, ...)                                                                      \
     do { if (!(cond)) return sph__fail(w, SPH_ERR_ARG, -1, __VA_ARGS__); } while (0)
@@ -2260,6 +2296,13 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
                        d->domain_lo[k] <= d->domain_hi[k],
                    "sph_world_def.domain_lo/hi[%d] = %g/%g: must be finite with lo <= hi", k,
                    (double)d->domain_lo[k], (double)d->domain_hi[k]);
+        if (fabs((double)d->domain_lo[k]) > sph__far_limit(d->spacing) ||
+            fabs((double)d->domain_hi[k]) > sph__far_limit(d->spacing)) {
+            char what[64];
+            const int hi = fabs((double)d->domain_hi[k]) > sph__far_limit(d->spacing);
+            snprintf(what, sizeof what, "sph_world_def.domain_%s[%d]", hi ? "hi" : "lo", k);
+            return sph__fail_far(w, d->spacing, -1, what, (double)(hi ? d->domain_hi[k] : d->domain_lo[k]));
+        }
     }
     return SPH_OK;
 }
@@ -2454,9 +2497,77 @@ static sph_real sph__pinf(const sph_phase* P) {
     return P->rest_density * P->sound_speed * P->sound_speed / P->gamma - P->back_pressure;
 }
 
+/* The rules for a phase, shared by sph_world_add_phase and the loader. Fills in the defaults
+   (gamma, the ideal gas's sound speed, the mass) of a phase as given; a saved phase (`saved`) has
+   them filled in already, so its gamma and mass must be set and an ideal gas's sound speed must
+   be the one that follows from its other fields. SPH_ERR_ARG naming the first bad field. */
+static sph_status sph__check_phase_fields(sph_world* w, sph_phase* ph, int saved) {
+    double vol;
+    int gas;
+#define SPH__PCHECK(cond, ...)                                                                     \
+    do { if (!(cond)) return sph__fail(w, SPH_ERR_ARG, -1, __VA_ARGS__); } while (0)
+    SPH__PCHECK(sph__finite((double)ph->rest_density) && ph->rest_density > 0,
+                "sph_phase.rest_density = %g: must be finite and > 0", (double)ph->rest_density);
+    SPH__PCHECK(sph__finite((double)ph->viscosity) && ph->viscosity >= 0,
+                "sph_phase.viscosity = %g: must be finite and >= 0", (double)ph->viscosity);
+    SPH__PCHECK(sph__finite((double)ph->sound_speed) && ph->sound_speed >= 0,
+                "sph_phase.sound_speed = %g: must be finite and >= 0 (0 = automatic)",
+                (double)ph->sound_speed);
+    SPH__PCHECK((int)ph->eos >= 0 && ph->eos <= SPH_EOS_STIFFENED_GAS,
+                "sph_phase.eos = %d: not a sph_eos", (int)ph->eos);
+    gas = ph->eos == SPH_EOS_IDEAL_GAS || ph->eos == SPH_EOS_STIFFENED_GAS;
+    SPH__PCHECK(sph__finite((double)ph->gamma) &&
+                    (ph->gamma == 0 || (ph->gamma >= 1 && ph->gamma <= 20)),
+                "sph_phase.gamma = %g: must be 0 (default) or in [1, 20]", (double)ph->gamma);
+    SPH__PCHECK(!saved || ph->gamma != 0, "sph_phase.gamma = 0: a saved phase has its gamma");
+    SPH__PCHECK(!gas || ph->gamma != 1,
+                "sph_phase.gamma = 1: a gas equation of state needs gamma > 1");
+    SPH__PCHECK(sph__finite((double)ph->back_pressure), "sph_phase.back_pressure = %g: not finite",
+                (double)ph->back_pressure);
+    SPH__PCHECK(sph__finite((double)ph->mass) && ph->mass >= 0,
+                "sph_phase.mass = %g: must be finite and >= 0 (0 = rest_density * dx^dim)",
+                (double)ph->mass);
+    SPH__PCHECK(!saved || ph->mass > 0, "sph_phase.mass = 0: a saved phase has its mass");
+    if (ph->gamma == 0)
+        ph->gamma = ph->eos == SPH_EOS_IDEAL_GAS       ? SPH__R(1.4)
+                    : ph->eos == SPH_EOS_STIFFENED_GAS ? SPH__R(4.4)
+                                                       : 7;
+    if (ph->eos == SPH_EOS_IDEAL_GAS) {
+        const double c =
+            sqrt((double)ph->gamma * (double)ph->back_pressure / (double)ph->rest_density);
+        SPH__PCHECK(ph->back_pressure >= 0,
+                    "sph_phase.back_pressure = %g: an ideal gas needs a pressure >= 0 (0: dust)",
+                    (double)ph->back_pressure);
+        SPH__PCHECK(saved ? ph->sound_speed == (sph_real)c : ph->sound_speed == 0,
+                    "sph_phase.sound_speed = %g: an ideal gas's sound speed follows from gamma, "
+                    "back_pressure and rest_density (here %g m/s); leave it 0",
+                    (double)ph->sound_speed, c);
+        ph->sound_speed = (sph_real)c;
+    }
+    if (ph->eos == SPH_EOS_STIFFENED_GAS) {
+        SPH__PCHECK(ph->sound_speed > 0,
+                    "sph_phase.sound_speed = 0: a stiffened gas needs its sound speed at rest "
+                    "density (it sets p_inf)");
+        SPH__PCHECK(sph__pinf(ph) >= 0,
+                    "sph_phase: a stiffened gas with rho0 c0^2 / gamma = %g Pa below its "
+                    "back_pressure %g Pa would have p_inf < 0; raise sound_speed or use an ideal gas",
+                    (double)(ph->rest_density * ph->sound_speed * ph->sound_speed / ph->gamma),
+                    (double)ph->back_pressure);
+    }
+    vol = (double)w->dx;
+    if (w->dim >= 2) vol *= (double)w->dx;
+    if (w->dim >= 3) vol *= (double)w->dx;
+    if (ph->mass == 0) ph->mass = (sph_real)((double)ph->rest_density * vol);
+    /* rest_density * dx^dim can leave sph_real (a denormal float density or spacing) */
+    SPH__PCHECK(sph__finite((double)ph->mass) && ph->mass > 0,
+                "sph_phase: the particle mass rest_density * dx^dim = %g is not finite and > 0 in "
+                "sph_real; set sph_phase.mass", (double)ph->rest_density * vol);
+#undef SPH__PCHECK
+    return SPH_OK;
+}
+
 SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase) {
     sph_phase ph;
-    double vol;
     int gas;
     if (!w) return -1;
     if (!phase) { sph__fail(w, SPH_ERR_ARG, -1, "sph_world_add_phase: phase is NULL"); return -1; }
@@ -2465,61 +2576,8 @@ SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase) {
         return -1;
     }
     ph = *phase;
-#define SPH__PCHECK(cond, ...)                                                                     \
-    do { if (!(cond)) { sph__fail(w, SPH_ERR_ARG, -1, __VA_ARGS__); return -1; } } while (0)
-    SPH__PCHECK(sph__finite((double)ph.rest_density) && ph.rest_density > 0,
-                "sph_phase.rest_density = %g: must be finite and > 0", (double)ph.rest_density);
-    SPH__PCHECK(sph__finite((double)ph.viscosity) && ph.viscosity >= 0,
-                "sph_phase.viscosity = %g: must be finite and >= 0", (double)ph.viscosity);
-    SPH__PCHECK(sph__finite((double)ph.sound_speed) && ph.sound_speed >= 0,
-                "sph_phase.sound_speed = %g: must be finite and >= 0 (0 = automatic)",
-                (double)ph.sound_speed);
-    SPH__PCHECK((int)ph.eos >= 0 && ph.eos <= SPH_EOS_STIFFENED_GAS,
-                "sph_phase.eos = %d: not a sph_eos", (int)ph.eos);
+    if (sph__check_phase_fields(w, &ph, 0) != SPH_OK) return -1;
     gas = ph.eos == SPH_EOS_IDEAL_GAS || ph.eos == SPH_EOS_STIFFENED_GAS;
-    SPH__PCHECK(sph__finite((double)ph.gamma) && (ph.gamma == 0 || (ph.gamma >= 1 && ph.gamma <= 20)),
-                "sph_phase.gamma = %g: must be 0 (default) or in [1, 20]", (double)ph.gamma);
-    SPH__PCHECK(!gas || ph.gamma != 1,
-                "sph_phase.gamma = 1: a gas equation of state needs gamma > 1");
-    SPH__PCHECK(sph__finite((double)ph.back_pressure), "sph_phase.back_pressure = %g: not finite",
-                (double)ph.back_pressure);
-    SPH__PCHECK(sph__finite((double)ph.mass) && ph.mass >= 0,
-                "sph_phase.mass = %g: must be finite and >= 0 (0 = rest_density * dx^dim)",
-                (double)ph.mass);
-    if (ph.gamma == 0)
-        ph.gamma = ph.eos == SPH_EOS_IDEAL_GAS       ? SPH__R(1.4)
-                   : ph.eos == SPH_EOS_STIFFENED_GAS ? SPH__R(4.4)
-                                                     : 7;
-    if (ph.eos == SPH_EOS_IDEAL_GAS) {
-        const double c = sqrt((double)ph.gamma * (double)ph.back_pressure / (double)ph.rest_density);
-        SPH__PCHECK(ph.back_pressure >= 0,
-                    "sph_phase.back_pressure = %g: an ideal gas needs a pressure >= 0 (0: dust)",
-                    (double)ph.back_pressure);
-        SPH__PCHECK(ph.sound_speed == 0,
-                    "sph_phase.sound_speed = %g: an ideal gas's sound speed follows from gamma, "
-                    "back_pressure and rest_density (here %g m/s); leave it 0",
-                    (double)ph.sound_speed, c);
-        ph.sound_speed = (sph_real)c;
-    }
-    if (ph.eos == SPH_EOS_STIFFENED_GAS) {
-        SPH__PCHECK(ph.sound_speed > 0,
-                    "sph_phase.sound_speed = 0: a stiffened gas needs its sound speed at rest "
-                    "density (it sets p_inf)");
-        SPH__PCHECK(sph__pinf(&ph) >= 0,
-                    "sph_phase: a stiffened gas with rho0 c0^2 / gamma = %g Pa below its "
-                    "back_pressure %g Pa would have p_inf < 0; raise sound_speed or use an ideal gas",
-                    (double)(ph.rest_density * ph.sound_speed * ph.sound_speed / ph.gamma),
-                    (double)ph.back_pressure);
-    }
-    vol = (double)w->dx;
-    if (w->dim >= 2) vol *= (double)w->dx;
-    if (w->dim >= 3) vol *= (double)w->dx;
-    if (ph.mass == 0) ph.mass = (sph_real)((double)ph.rest_density * vol);
-    /* rest_density * dx^dim can leave sph_real (a denormal float density or spacing) */
-    SPH__PCHECK(sph__finite((double)ph.mass) && ph.mass > 0,
-                "sph_phase: the particle mass rest_density * dx^dim = %g is not finite and > 0 in "
-                "sph_real; set sph_phase.mass", (double)ph.rest_density * vol);
-#undef SPH__PCHECK
     if (gas && !w->priv.has_energy) { /* the internal energy array, from now on */
         size_t i;
         if (!sph__grow((void**)&w->e, w->capacity, sizeof(sph_real))) {
@@ -2590,19 +2648,29 @@ static int sph__all_finite(const sph_real* a, size_t count, size_t* bad) {
     return 1;
 }
 
-/* The checks both ways of adding fluid share; fn names the caller in the message. */
-static sph_status sph__add_fluid_checked(sph_world* w, const char* fn, int phase, size_t n,
-                                         const sph_real* x, const sph_real* v, const sph_real* m,
-                                         const sph_real* rho) {
-    size_t bad = 0, dim;
-    if (!w) return SPH_ERR_ARG;
-    if (!sph__check_phase(w, phase)) return SPH_ERR_ARG;
+/* A position beyond the far limit (sph__far_limit) among n particles of dimension dim: the
+   message names the caller, the particle and the component. */
+static sph_status sph__check_far(sph_world* w, const char* fn, const char* kind, size_t n,
+                                 const sph_real* x) {
+    const size_t dim = (size_t)w->dim, bad = sph__first_far(x, n * dim, sph__far_limit(w->dx));
+    char what[96];
+    if (bad == n * dim) return SPH_OK;
+    snprintf(what, sizeof what, "%s: %sparticle %zu at x[%zu]", fn, kind, bad / dim, bad % dim);
+    return sph__fail_far(w, w->dx, (long)(bad / dim), what, (double)x[bad]);
+}
+
+/* The rules for fluid particles, shared by both ways of adding fluid and by the loader; fn
+   names the caller in the message. m and rho may be NULL (not given). */
+static sph_status sph__check_fluid(sph_world* w, const char* fn, size_t n, const sph_real* x,
+                                   const sph_real* v, const sph_real* m, const sph_real* rho) {
+    size_t bad = 0, dim = (size_t)w->dim;
+    sph_status s;
     if (n == 0) return SPH_OK;
     if (!x) return sph__fail(w, SPH_ERR_ARG, -1, "%s: x is NULL", fn);
-    dim = (size_t)w->dim;
     if (!sph__all_finite(x, n * dim, &bad))
         return sph__fail(w, SPH_ERR_ARG, (long)(bad / dim),
                          "%s: x of particle %zu is not finite (%g)", fn, bad / dim, (double)x[bad]);
+    if ((s = sph__check_far(w, fn, "", n, x)) != SPH_OK) return s;
     if (v && !sph__all_finite(v, n * dim, &bad))
         return sph__fail(w, SPH_ERR_ARG, (long)(bad / dim),
                          "%s: v of particle %zu is not finite (%g)", fn, bad / dim, (double)v[bad]);
@@ -2616,6 +2684,17 @@ static sph_status sph__add_fluid_checked(sph_world* w, const char* fn, int phase
             return sph__fail(w, SPH_ERR_ARG, (long)bad,
                              "%s: density of particle %zu is %g: must be finite and > 0", fn, bad,
                              (double)rho[bad]);
+    return SPH_OK;
+}
+
+static sph_status sph__add_fluid_checked(sph_world* w, const char* fn, int phase, size_t n,
+                                         const sph_real* x, const sph_real* v, const sph_real* m,
+                                         const sph_real* rho) {
+    sph_status s;
+    if (!w) return SPH_ERR_ARG;
+    if (!sph__check_phase(w, phase)) return SPH_ERR_ARG;
+    if (n == 0) return SPH_OK;
+    if ((s = sph__check_fluid(w, fn, n, x, v, m, rho)) != SPH_OK) return s;
     return sph__append_fluid(w, phase, n, x, v, w->phases[phase].mass, m, rho);
 }
 
@@ -2638,6 +2717,14 @@ static sph_status sph__check_box(sph_world* w, const char* fn, const sph_real* l
             return sph__fail(w, SPH_ERR_ARG, -1,
                              "%s: box [%g, %g] in direction %d must be finite with lo < hi", fn,
                              (double)lo[k], (double)hi[k], k);
+    for (k = 0; k < w->dim; ++k) {
+        const int high = fabs((double)hi[k]) > sph__far_limit(w->dx);
+        if (high || fabs((double)lo[k]) > sph__far_limit(w->dx)) {
+            char what[96];
+            snprintf(what, sizeof what, "%s: %s[%d]", fn, high ? "hi" : "lo", k);
+            return sph__fail_far(w, w->dx, -1, what, (double)(high ? hi[k] : lo[k]));
+        }
+    }
     return SPH_OK;
 }
 
@@ -2715,30 +2802,37 @@ static sph_status sph__append_boundary(sph_world* w, size_t n, const sph_real* x
     return SPH_OK;
 }
 
+/* The rules for boundary particles, shared by sph_add_boundary and the loader; vol may be NULL
+   (dx^dim). */
+static sph_status sph__check_boundary(sph_world* w, const char* fn, size_t n, const sph_real* x,
+                                      const sph_real* vol, int body) {
+    size_t bad = 0, i, dim = (size_t)w->dim;
+    sph_status s;
+    if (n == 0) return SPH_OK;
+    if (!x) return sph__fail(w, SPH_ERR_ARG, -1, "%s: x is NULL", fn);
+    if (body < 0 || body > 65535)
+        return sph__fail(w, SPH_ERR_ARG, -1, "%s: body = %d: must be in [0, 65535]", fn, body);
+    if (!sph__all_finite(x, n * dim, &bad))
+        return sph__fail(w, SPH_ERR_ARG, (long)(bad / dim),
+                         "%s: x of particle %zu is not finite (%g)", fn, bad / dim, (double)x[bad]);
+    if ((s = sph__check_far(w, fn, "boundary ", n, x)) != SPH_OK) return s;
+    for (i = 0; vol && i < n; ++i)
+        if (!sph__finite((double)vol[i]) || !(vol[i] > 0))
+            return sph__fail(w, SPH_ERR_ARG, (long)i,
+                             "%s: vol of particle %zu = %g: must be finite and > 0", fn, i,
+                             (double)vol[i]);
+    return SPH_OK;
+}
+
 SPHDEF sph_status sph_add_boundary(sph_world* w, size_t n, const sph_real* x, const sph_real* vol,
                                    int body) {
-    size_t bad = 0, i, dim;
+    size_t i;
     sph_real* v0 = NULL;
     sph_status s;
     if (!w) return SPH_ERR_ARG;
     if (n == 0) return SPH_OK;
-    dim = (size_t)w->dim;
-    if (!x) return sph__fail(w, SPH_ERR_ARG, -1, "sph_add_boundary: x is NULL");
-    if (body < 0 || body > 65535)
-        return sph__fail(w, SPH_ERR_ARG, -1, "sph_add_boundary: body = %d: must be in [0, 65535]",
-                         body);
-    if (!sph__all_finite(x, n * dim, &bad))
-        return sph__fail(w, SPH_ERR_ARG, (long)(bad / dim),
-                         "sph_add_boundary: x of particle %zu is not finite (%g)", bad / dim,
-                         (double)x[bad]);
-    if (vol) {
-        for (i = 0; i < n; ++i)
-            if (!sph__finite((double)vol[i]) || !(vol[i] > 0))
-                return sph__fail(w, SPH_ERR_ARG, (long)i,
-                                 "sph_add_boundary: vol of particle %zu = %g: must be finite and > 0",
-                                 i, (double)vol[i]);
-        return sph__append_boundary(w, n, x, vol, body);
-    }
+    if ((s = sph__check_boundary(w, "sph_add_boundary", n, x, vol, body)) != SPH_OK) return s;
+    if (vol) return sph__append_boundary(w, n, x, vol, body);
     v0 = (sph_real*)SPH_MALLOC(n * sizeof(sph_real));
     if (!v0) return sph__fail(w, SPH_ERR_NOMEM, -1, "sph_add_boundary: out of memory");
     for (i = 0; i < n; ++i)
@@ -2777,6 +2871,15 @@ SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_r
         return sph__fail(w, SPH_ERR_ARG, -1, "sph_add_wall_box: open_faces = %u: not SPH_FACE_* bits",
                          open_faces);
     if (layers == 0) layers = (int)ceil((double)(w->kernel.radius / w->dx) - 1e-9);
+    for (k = 0; k < dim; ++k) { /* the outermost layers, as sph_add_boundary would check them */
+        const double depth = (double)layers * (double)w->dx;
+        const double a = (double)lo[k] - depth, b = (double)hi[k] + depth;
+        if (fabs(a) > sph__far_limit(w->dx) || fabs(b) > sph__far_limit(w->dx)) {
+            char what[96];
+            snprintf(what, sizeof what, "sph_add_wall_box: its outer layer at x[%d]", k);
+            return sph__fail_far(w, w->dx, -1, what, fabs(b) > fabs(a) ? b : a);
+        }
+    }
     for (k = 0; k < dim; ++k) { /* the wall count first, before anything is allocated */
         double span = (double)((hi[k] - lo[k]) / w->dx), ni;
         /* before the conversion: a span beyond size_t (or hi - lo overflowing to inf) would make
@@ -3828,6 +3931,7 @@ static void sph__stage_body_force(sph_world* w, const sph__ctx* c) {
    densities written by the host between steps. Nothing is changed. */
 static sph_status sph__check_step_input(sph_world* w, sph_real dt) {
     const size_t D = (size_t)w->dim;
+    const double far = sph__far_limit(w->dx); /* positions the host wrote far away */
     size_t i, k;
     if (!sph__finite((double)dt) || !(dt > 0))
         return sph__fail(w, SPH_ERR_ARG, -1, "step: dt = %g: must be finite and > 0", (double)dt);
@@ -3846,7 +3950,8 @@ static sph_status sph__check_step_input(sph_world* w, sph_real dt) {
                         (w->e && !sph__finite((double)w->e[j]));
             for (kk = 0; kk < (int)D; ++kk)
                 b |= !sph__finite((double)w->x[(size_t)j * D + (size_t)kk]) ||
-                     !sph__finite((double)w->v[(size_t)j * D + (size_t)kk]);
+                     !sph__finite((double)w->v[(size_t)j * D + (size_t)kk]) ||
+                     fabs((double)w->x[(size_t)j * D + (size_t)kk]) > far;
             bad |= b;
         }
         if (!bad) i = w->n; /* skip the serial search below */
@@ -3858,6 +3963,12 @@ static sph_status sph__check_step_input(sph_world* w, sph_real dt) {
                 return sph__fail(w, SPH_ERR_ARG, (long)i,
                                  "step: fluid particle %zu (id %u) has a non-finite position", i,
                                  (unsigned)w->id[i]);
+            if (fabs((double)w->x[i * D + k]) > far) {
+                char what[96];
+                snprintf(what, sizeof what, "step: fluid particle %zu (id %u) at x[%zu]", i,
+                         (unsigned)w->id[i], k);
+                return sph__fail_far(w, w->dx, (long)i, what, (double)w->x[i * D + k]);
+            }
             if (!sph__finite((double)w->v[i * D + k]))
                 return sph__fail(w, SPH_ERR_ARG, (long)i,
                                  "step: fluid particle %zu (id %u) has a non-finite velocity", i,
@@ -3872,11 +3983,17 @@ static sph_status sph__check_step_input(sph_world* w, sph_real dt) {
                              "step: fluid particle %zu (id %u) has a non-finite internal energy", i,
                              (unsigned)w->id[i]);
     }
-    for (i = 0; i < w->nb * D; ++i)
+    for (i = 0; i < w->nb * D; ++i) {
         if (!sph__finite((double)w->b_x[i]) || !sph__finite((double)w->b_v[i]))
             return sph__fail(w, SPH_ERR_ARG, (long)(i / D),
                              "step: boundary particle %zu has a non-finite position or velocity",
                              i / D);
+        if (fabs((double)w->b_x[i]) > far) {
+            char what[96];
+            snprintf(what, sizeof what, "step: boundary particle %zu at x[%zu]", i / D, i % D);
+            return sph__fail_far(w, w->dx, (long)(i / D), what, (double)w->b_x[i]);
+        }
+    }
     return SPH_OK;
 }
 
@@ -3892,6 +4009,13 @@ static sph_status sph__boundary_motion(sph_world* w, double t) {
                              "boundary motion callback: boundary particle %zu (id %u) got a "
                              "non-finite position, velocity or acceleration at t = %g",
                              i / D, (unsigned)w->b_id[i / D], t);
+    i = sph__first_far(w->b_x, w->nb * D, sph__far_limit(w->dx));
+    if (i < w->nb * D) {
+        char what[128];
+        snprintf(what, sizeof what, "boundary motion callback: boundary particle %zu (id %u) at x[%zu]",
+                 i / D, (unsigned)w->b_id[i / D], i % D);
+        return sph__fail_far(w, w->dx, (long)(i / D), what, (double)w->b_x[i]);
+    }
     return SPH_OK;
 }
 
@@ -5907,6 +6031,124 @@ static sph_status sph__load_fail(sph_world* w, sph_status s, const char* fmt, ..
     return sph__fail(w, s, -1, "sph_world_load: %s", msg);
 }
 
+/* A loaded world is checked field by field with the rules of the API that sets each field
+   (sph_world_init for the def, sph_world_add_phase for the phases, sph_add_fluid_ex and
+   sph_add_boundary for the particles, the step's input check for what the host may write): the
+   checksum only catches accidents, a file written by another program (or edited) must not
+   reach a step with values the API would have refused. On a failure the world is freed and the
+   message of the failed rule kept, prefixed with `prefix` (which names the phase or array). */
+static sph_status sph__load_reject(sph_world* w, const char* prefix) {
+    char msg[SPH_ERROR_SIZE];
+    const long index = w->error_index;
+    const sph_status s = w->status;
+    memcpy(msg, w->error, sizeof msg);
+    sph_world_free(w);
+    return sph__fail(w, s, index, "%s%s", prefix, msg);
+}
+
+static int sph__u32_cmp(const void* a, const void* b) {
+    const uint32_t x = *(const uint32_t*)a, y = *(const uint32_t*)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Ids are unique and below the next id to hand out (else a later particle would share one). */
+static sph_status sph__check_ids(sph_world* w, const char* what, const uint32_t* id, size_t n,
+                                 uint32_t next) {
+    uint32_t* sorted;
+    size_t i;
+    for (i = 0; i < n; ++i)
+        if (id[i] >= next)
+            return sph__fail(w, SPH_ERR_ARG, (long)i,
+                             "sph_world_load: %s particle %zu has id %u, not below the next id %u",
+                             what, i, (unsigned)id[i], (unsigned)next);
+    if (n < 2) return SPH_OK;
+    sorted = (uint32_t*)SPH_MALLOC(n * sizeof(uint32_t));
+    if (!sorted) return sph__fail(w, SPH_ERR_NOMEM, -1, "sph_world_load: out of memory (ids)");
+    memcpy(sorted, id, n * sizeof(uint32_t));
+    qsort(sorted, n, sizeof(uint32_t), sph__u32_cmp);
+    for (i = 1; i < n && sorted[i] != sorted[i - 1]; ++i) {}
+    if (i < n) {
+        const uint32_t dup = sorted[i];
+        SPH_FREE(sorted);
+        for (i = 0; id[i] != dup; ++i) {}
+        return sph__fail(w, SPH_ERR_ARG, (long)i,
+                         "sph_world_load: %s particle %zu has id %u, which another particle has too",
+                         what, i, (unsigned)dup);
+    }
+    SPH_FREE(sorted);
+    return SPH_OK;
+}
+
+/* Every value of a real array finite (name: the array, for the message). */
+static sph_status sph__check_loaded_finite(sph_world* w, const char* name, const sph_real* a,
+                                           size_t count, size_t stride) {
+    size_t bad = 0;
+    if (count && !sph__all_finite(a, count, &bad))
+        return sph__fail(w, SPH_ERR_ARG, (long)(bad / stride),
+                         "sph_world_load: %s of particle %zu is not finite (%g)", name,
+                         bad / stride, (double)a[bad]);
+    return SPH_OK;
+}
+
+/* The fields of a loaded world beyond the def and the phases (which the loader checks as it
+   reads them). */
+static sph_status sph__check_loaded(sph_world* w) {
+    const size_t D = (size_t)w->dim, n = w->n, nb = w->nb;
+    const double* st[9];
+    size_t i;
+    sph_status s;
+    int k;
+    if (!sph__finite(w->time))
+        return sph__fail(w, SPH_ERR_ARG, -1, "sph_world_load: time = %g: must be finite", w->time);
+    if (!sph__finite(w->step_time_total) || w->step_time_total < 0)
+        return sph__fail(w, SPH_ERR_ARG, -1, "sph_world_load: step_time_total = %g: must be "
+                         "finite and >= 0", w->step_time_total);
+    for (k = 0; k < SPH_STAGE_COUNT; ++k)
+        if (!sph__finite(w->stage_time_total[k]) || w->stage_time_total[k] < 0)
+            return sph__fail(w, SPH_ERR_ARG, -1, "sph_world_load: stage_time_total[%d] = %g: must "
+                             "be finite and >= 0", k, w->stage_time_total[k]);
+    /* the statistics: sph_stable_dt reads a_max (the force limit) */
+    st[0] = &w->stats.dt; st[1] = &w->stats.solver_error; st[2] = &w->stats.density_error_avg;
+    st[3] = &w->stats.density_error_max; st[4] = &w->stats.compression_avg;
+    st[5] = &w->stats.v_max; st[6] = &w->stats.a_max; st[7] = &w->stats.kinetic_energy;
+    st[8] = &w->stats.step_time;
+    for (k = 0; k < 9; ++k)
+        if (!sph__finite(*st[k]) || (k >= 5 && *st[k] < 0))
+            return sph__fail(w, SPH_ERR_ARG, -1, "sph_world_load: stats field %d = %g: must be "
+                             "finite%s", k, *st[k], k >= 5 ? " and >= 0" : "");
+    if (n > 0 && !w->priv.have_mass)
+        return sph__fail(w, SPH_ERR_ARG, -1, "sph_world_load: %zu fluid particles but no mass", n);
+    if (w->priv.have_mass && (!sph__finite((double)w->mass) || !(w->mass > 0)))
+        return sph__fail(w, SPH_ERR_ARG, -1, "sph_world_load: mass = %g: must be finite and > 0",
+                         (double)w->mass);
+    /* the rules of sph_add_fluid_ex: positions (finite, near enough to the origin), velocities,
+       masses, densities */
+    if ((s = sph__check_fluid(w, "sph_world_load", n, w->x, w->v, w->m, w->rho)) != SPH_OK)
+        return s;
+    for (i = 0; i < n; ++i)
+        if (w->phase[i] >= w->nphase)
+            return sph__fail(w, SPH_ERR_ARG, (long)i, "sph_world_load: particle %zu has phase %u: "
+                             "phase %u does not exist (the world has %d phases)", i,
+                             (unsigned)w->phase[i], (unsigned)w->phase[i], w->nphase);
+    if ((s = sph__check_loaded_finite(w, "pressure", w->p, n, 1)) != SPH_OK ||
+        (s = sph__check_loaded_finite(w, "density rate", w->drho, n, 1)) != SPH_OK ||
+        (s = sph__check_loaded_finite(w, "acceleration", w->a, n * D, D)) != SPH_OK ||
+        (w->e && (s = sph__check_loaded_finite(w, "internal energy", w->e, n, 1)) != SPH_OK))
+        return s;
+    if ((s = sph__check_ids(w, "fluid", w->id, n, w->next_id)) != SPH_OK) return s;
+    /* the rules of sph_add_boundary (body tags are 16 bits: always in range) */
+    if ((s = sph__check_boundary(w, "sph_world_load", nb, w->b_x, w->b_vol, 0)) != SPH_OK ||
+        (s = sph__check_loaded_finite(w, "boundary velocity", w->b_v, nb * D, D)) != SPH_OK ||
+        (s = sph__check_loaded_finite(w, "boundary acceleration", w->b_a, nb * D, D)) != SPH_OK ||
+        (s = sph__check_loaded_finite(w, "boundary b_x0", w->b_x0, nb * D, D)) != SPH_OK ||
+        (s = sph__check_loaded_finite(w, "boundary pressure", w->b_p, nb, 1)) != SPH_OK ||
+        (s = sph__check_loaded_finite(w, "boundary density", w->b_rho, nb, 1)) != SPH_OK ||
+        (s = sph__check_loaded_finite(w, "boundary b_vw", w->b_vw, nb * D, D)) != SPH_OK ||
+        (s = sph__check_loaded_finite(w, "boundary b_sw", w->priv.b_sw, nb, 1)) != SPH_OK)
+        return s;
+    return sph__check_ids(w, "boundary", w->b_id, nb, w->b_next_id);
+}
+
 SPHDEF sph_status sph_world_load_mem(sph_world* w, const void* buf, size_t size,
                                      const sph_world_def* callbacks) {
     sph__src in;
@@ -5963,10 +6205,13 @@ SPHDEF sph_status sph_world_load_mem(sph_world* w, const void* buf, size_t size,
         return sph__load_fail(w, SPH_ERR_IO, "truncated phases");
     w->nphase = (int)nphase;
     for (k = 0; k < w->nphase; ++k) {
-        const sph_phase* P = &w->phases[k];
-        if (!(P->rest_density > 0) || (int)P->eos < 0 || P->eos > SPH_EOS_STIFFENED_GAS)
-            return sph__load_fail(w, SPH_ERR_IO, "phase %d is invalid", k);
-        if (P->eos == SPH_EOS_IDEAL_GAS || P->eos == SPH_EOS_STIFFENED_GAS) w->priv.has_energy = 1;
+        sph_phase P = w->phases[k];
+        if (sph__check_phase_fields(w, &P, 1) != SPH_OK) {
+            char prefix[48];
+            snprintf(prefix, sizeof prefix, "sph_world_load: phase %d: ", k);
+            return sph__load_reject(w, prefix);
+        }
+        if (P.eos == SPH_EOS_IDEAL_GAS || P.eos == SPH_EOS_STIFFENED_GAS) w->priv.has_energy = 1;
     }
     if (!sph__get(&in, &w->time, sizeof w->time) || !sph__get(&in, &steps, 8) ||
         !sph__get(&in, &w->step_time_total, sizeof w->step_time_total) ||
@@ -6003,10 +6248,7 @@ SPHDEF sph_status sph_world_load_mem(sph_world* w, const void* buf, size_t size,
     }
     w->n = n;
     w->nb = nb;
-    for (i = 0; i < n; ++i)
-        if (w->phase[i] >= nphase)
-            return sph__load_fail(w, SPH_ERR_IO, "particle %zu has phase %u of %u", i,
-                                  (unsigned)w->phase[i], (unsigned)nphase);
+    if (sph__check_loaded(w) != SPH_OK) return sph__load_reject(w, "");
     w->priv.b_dirty = nb > 0; /* the boundary grid (and Akinci volumes) are rebuilt */
     if (!sph__get(&in, &soc, 4)) return sph__load_fail(w, SPH_ERR_IO, "truncated");
     if (soc) {

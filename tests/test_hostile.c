@@ -7,6 +7,7 @@
 #include "../sph.h"
 
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -157,16 +158,17 @@ static void test_wall_box_matches_lattice_walk(void) {
     TH_NOTE("%d wall boxes identical to the whole-lattice walk", cases);
 }
 
-/* A box whose lattice the old walk could not even allocate: 2D, 1e5 x 1e5 spacings (1e10
-   lattice points, SPH_ERR_CAPACITY before; 4e5 wall particles), and a 3D open box of 600^3
-   spacings with only its floor and one side closed (2.2e8 lattice points: 7 GB of scratch and
-   seconds before; 7.3e5 wall particles). Both take well under a second now. The capacity rule
-   counts wall particles: a 3D closed box of 1e6^3 spacings (6e12 walls) is refused before it
-   allocates anything. */
+/* Boxes whose lattice is much larger than their walls. 2D, 16000 x 16000 spacings (as large as
+   a float world centred on the origin may be, see far_coordinates_rejected): 2.6e8 lattice
+   points, 6 GB of scratch and seconds before, 6.4e4 wall particles. In double also 1e5 x 1e5
+   spacings (1e10 lattice points: SPH_ERR_CAPACITY before; 4e5 wall particles). 3D, 600^3
+   spacings with only the floor and one side closed (2.2e8 lattice points, 7.3e5 walls). The
+   capacity rule counts wall particles: a closed 16000^3 box 3 layers deep (4.6e9 walls) is
+   refused before anything is allocated. */
 static void test_wall_box_cost_follows_surface(void) {
     sph_world w;
     sph_world_def d = sph_world_def_default(2);
-    sph_real lo[3] = {0, 0, 0}, hi[3] = {1000, 1000, 0};
+    sph_real lo[3] = {-80, -80, -80}, hi[3] = {80, 80, 80};
     double t0, t;
     unsigned long allocs;
     d.spacing = (sph_real)0.01;
@@ -174,36 +176,348 @@ static void test_wall_box_cost_follows_surface(void) {
     t0 = hs_now();
     CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 1, 0), SPH_OK);
     t = hs_now() - t0;
-    CHECK_EQ_INT(w.nb, 100002ull * 100002ull - 100000ull * 100000ull);
-    CHECK_LT(t, 2.0);
-    TH_NOTE("2D 1e5 x 1e5 spacings, 1 layer: %zu wall particles in %.3f s", w.nb, t);
+    CHECK_EQ_INT(w.nb, 16002ull * 16002ull - 16000ull * 16000ull);
+    CHECK_LT(t, 0.5);
+    TH_NOTE("2D 16000^2 spacings, 1 layer: %zu wall particles in %.3f s", w.nb, t);
     sph_world_free(&w);
+    if (sizeof(sph_real) == 8) {
+        sph_real lo2[2] = {0, 0}, hi2[2] = {1000, 1000};
+        CHECK_EQ_INT(sph_world_init(&w, &d), SPH_OK);
+        t0 = hs_now();
+        CHECK_EQ_INT(sph_add_wall_box(&w, lo2, hi2, 1, 0), SPH_OK);
+        t = hs_now() - t0;
+        CHECK_EQ_INT(w.nb, 100002ull * 100002ull - 100000ull * 100000ull);
+        CHECK_LT(t, 2.0);
+        TH_NOTE("2D 1e5^2 spacings, 1 layer: %zu wall particles in %.3f s", w.nb, t);
+        sph_world_free(&w);
+    }
 
     d = sph_world_def_default(3);
     d.spacing = (sph_real)0.01;
-    hi[0] = hi[1] = hi[2] = 6;
     CHECK_EQ_INT(sph_world_init(&w, &d), SPH_OK);
-    t0 = hs_now();
-    CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 1,
-                                  SPH_FACE_XMAX | SPH_FACE_YMAX | SPH_FACE_ZMIN | SPH_FACE_ZMAX),
-                 SPH_OK);
-    t = hs_now() - t0;
+    {
+        sph_real lo3[3] = {0, 0, 0}, hi3[3] = {6, 6, 6};
+        t0 = hs_now();
+        CHECK_EQ_INT(sph_add_wall_box(&w, lo3, hi3, 1,
+                                      SPH_FACE_XMAX | SPH_FACE_YMAX | SPH_FACE_ZMIN | SPH_FACE_ZMAX),
+                     SPH_OK);
+        t = hs_now() - t0;
+    }
     /* floor (y layer below, x from the closed layer through the box) and the xmin side */
     CHECK_EQ_INT(w.nb, 601 * 600 + 600 * 600);
     CHECK_LT(t, 2.0);
     TH_NOTE("3D 600^3 spacings, floor and one side: %zu wall particles in %.3f s", w.nb, t);
-    hi[0] = hi[1] = hi[2] = 1e4; /* 1e6 spacings per side */
     th_alloc_fail_at(0);
-    CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 1, 0), SPH_ERR_CAPACITY);
+    CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 3, 0), SPH_ERR_CAPACITY);
     allocs = th_alloc_count();
     CHECK_EQ_INT(allocs, 0);
-    CHECK(strstr(w.error, "wall particles") != NULL);
+    CHECK_MSG(strstr(w.error, "wall particles") != NULL, "%s", w.error);
     CHECK_EQ_INT(w.nb, 601 * 600 + 600 * 600);
+    sph_world_free(&w);
+}
+
+/* ---- loaded files are checked like the API's input -------------------------------------------- */
+
+/* A small tank: 2D water 10 x 8 at dx = 0.02 in walls, 5 WCSPH steps taken. */
+static int hs_tank(sph_world* w, double x0) {
+    sph_world_def d = sph_world_def_default(2);
+    sph_phase water;
+    sph_real lo[2], hi[2], whi[2];
+    int q;
+    memset(&water, 0, sizeof water);
+    water.rest_density = 1000;
+    d.spacing = (sph_real)0.02;
+    lo[0] = (sph_real)x0;
+    lo[1] = 0;
+    hi[0] = (sph_real)(x0 + 0.2);
+    hi[1] = (sph_real)0.16;
+    whi[0] = hi[0];
+    whi[1] = (sph_real)0.24;
+    if (sph_world_init(w, &d) != SPH_OK || sph_world_add_phase(w, &water) != 0 ||
+        sph_fill_box(w, 0, lo, hi) != SPH_OK || sph_add_wall_box(w, lo, whi, 0, SPH_FACE_YMAX) != SPH_OK ||
+        sph_set_hydrostatic(w) != SPH_OK)
+        return 0;
+    for (q = 0; q < 5; ++q)
+        if (sph_step(w, sph_stable_dt(w, SPH_SOLVER_WCSPH)) != SPH_OK) return 0;
+    return 1;
+}
+
+/* FNV-1a 64 over all bytes but the last 8, which it replaces: the loader's checksum, so that an
+   edited file reaches the field checks. */
+static void hs_rehash(unsigned char* b, size_t n) {
+    uint64_t h = 14695981039346656037ull;
+    size_t i;
+    for (i = 0; i + 8 < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
+    memcpy(b + n - 8, &h, 8);
+}
+
+/* Byte offsets of the saved layout (sph__save): header, def, phases, scalars, stats, arrays. */
+typedef struct hs_layout {
+    size_t phases, time, next_id, mass, stats, fluid, boundary; /* fluid/boundary: array count */
+} hs_layout;
+
+static hs_layout hs_layout_of(const unsigned char* b, int nphase) {
+    hs_layout L;
+    size_t at = 8 + 8 * 4 + sizeof(sph_world_def);
+    uint32_t na, elem, k;
+    uint64_t n;
+    L.phases = at + 4;
+    at = L.phases + (size_t)nphase * sizeof(sph_phase);
+    L.time = at;
+    at += 8 + 8 + 8 + 8 * SPH_STAGE_COUNT; /* time, steps, step_time_total, stage_time_total */
+    memcpy(&n, b + at, 8);
+    L.next_id = at + 16;
+    L.mass = L.next_id + 16; /* next ids, has_m, have_mass */
+    L.stats = L.mass + sizeof(sph_real);
+    L.fluid = L.stats + sizeof(sph_stats);
+    at = L.fluid;
+    memcpy(&na, b + at, 4);
+    at += 4;
+    for (k = 0; k < na; ++k) {
+        memcpy(&elem, b + at, 4);
+        at += 4 + (size_t)n * elem;
+    }
+    L.boundary = at;
+    return L;
+}
+
+/* Offset of the data of array `index` in the list starting at `list` (count = particles). */
+static size_t hs_array(const unsigned char* b, size_t list, int index, size_t count) {
+    size_t at = list + 4;
+    uint32_t elem;
+    int k;
+    for (k = 0; k < index; ++k) {
+        memcpy(&elem, b + at, 4);
+        at += 4 + count * elem;
+    }
+    return at + 4;
+}
+
+static void hs_put_real(unsigned char* b, size_t at, double v) {
+    sph_real r = (sph_real)v;
+    memcpy(b + at, &r, sizeof r);
+}
+
+/* Each edit of issue 19 (and a few more), with a recomputed checksum: the loader refuses it with
+   SPH_ERR_ARG and a message naming the field (the rule's message from the API), and leaves the
+   world freed (n = 0, no arrays). Before, every one loaded with SPH_OK and stepped. The intact
+   bytes still load to the same world. */
+static void test_load_checks_fields(void) {
+    sph_world a, b;
+    unsigned char *bytes, *copy;
+    size_t n, i, xoff, nf, nbw;
+    hs_layout L;
+    int e, cases = 0;
+    uint32_t zero = 0;
+    static const char* const expect[] = {
+        "mass = -1",        "sph_phase.gamma = -3", "sph_phase.sound_speed = -5",
+        "sph_phase.viscosity = -1e+09", "vol of particle 0 = -1", "time = nan",
+        "id",               "pressure of particle 0", "x of particle 3 is not finite",
+        "density of particle 2", "v of particle 1", "phase 7 does not exist",
+        "too far from the origin", "b_x0 of particle", "stats field",
+        "sph_phase.mass = -2",
+    };
+    CHECK(hs_tank(&a, 0));
+    n = sph_world_save_mem(&a, NULL, 0);
+    bytes = (unsigned char*)malloc(n);
+    copy = (unsigned char*)malloc(n);
+    CHECK_EQ_INT(sph_world_save_mem(&a, bytes, n), n);
+    L = hs_layout_of(bytes, a.nphase);
+    nf = a.n;
+    nbw = a.nb;
+    for (e = 0; e < (int)(sizeof expect / sizeof expect[0]); ++e) {
+        sph_status s;
+        memcpy(copy, bytes, n);
+        switch (e) {
+        case 0: hs_put_real(copy, L.mass, -1); break;
+        case 1: hs_put_real(copy, L.phases + offsetof(sph_phase, gamma), -3); break;
+        case 2: hs_put_real(copy, L.phases + offsetof(sph_phase, sound_speed), -5); break;
+        case 3: hs_put_real(copy, L.phases + offsetof(sph_phase, viscosity), -1e9); break;
+        case 4: /* every wall volume */
+            xoff = hs_array(copy, L.boundary, 4, nbw);
+            for (i = 0; i < nbw; ++i) hs_put_real(copy, xoff + i * sizeof(sph_real), -1);
+            break;
+        case 5: { double t = NAN; memcpy(copy + L.time, &t, 8); } break;
+        case 6: /* all ids equal, next id 0 */
+            xoff = hs_array(copy, L.fluid, 4, nf);
+            for (i = 0; i < nf; ++i) memcpy(copy + xoff + 4 * i, &zero, 4);
+            memcpy(copy + L.next_id, &zero, 4);
+            break;
+        case 7: hs_put_real(copy, hs_array(copy, L.fluid, 3, nf), NAN); break;
+        case 8: hs_put_real(copy, hs_array(copy, L.fluid, 0, nf) + 7 * sizeof(sph_real), NAN); break;
+        case 9: hs_put_real(copy, hs_array(copy, L.fluid, 2, nf) + 2 * sizeof(sph_real), -1); break;
+        case 10: hs_put_real(copy, hs_array(copy, L.fluid, 1, nf) + 3 * sizeof(sph_real), INFINITY); break;
+        case 11: copy[hs_array(copy, L.fluid, 5, nf) + 4] = 7; break;
+        case 12: hs_put_real(copy, hs_array(copy, L.fluid, 0, nf) + 4 * sizeof(sph_real), 1e30); break;
+        case 13: hs_put_real(copy, hs_array(copy, L.boundary, 3, nbw) + sizeof(sph_real), NAN); break;
+        case 14: { double v = -1; memcpy(copy + L.stats + offsetof(sph_stats, a_max), &v, 8); } break;
+        default: hs_put_real(copy, L.phases + offsetof(sph_phase, mass), -2); break;
+        }
+        hs_rehash(copy, n);
+        s = sph_world_load_mem(&b, copy, n, NULL);
+        CHECK_MSG(s == SPH_ERR_ARG, "edit %d (%s): status %d (%s)", e, expect[e], (int)s, b.error);
+        CHECK_MSG(strstr(b.error, expect[e]) != NULL && strstr(b.error, "sph_world_load") != NULL,
+                  "edit %d: message '%s' lacks '%s'", e, b.error, expect[e]);
+        CHECK(b.n == 0 && b.nb == 0 && b.x == NULL && b.b_x == NULL && b.nphase == 0);
+        if (s == SPH_OK) { /* before the fix: a first step even succeeded */
+            TH_NOTE("edit %d loaded; step: %s", e, sph_status_string(sph_step(&b, (sph_real)1e-5)));
+        }
+        sph_world_free(&b);
+        ++cases;
+    }
+    /* a phase index error names the particle */
+    memcpy(copy, bytes, n);
+    copy[hs_array(copy, L.fluid, 5, nf) + 4] = 7;
+    hs_rehash(copy, n);
+    CHECK_EQ_INT(sph_world_load_mem(&b, copy, n, NULL), SPH_ERR_ARG);
+    CHECK_EQ_INT(b.error_index, 4);
+    sph_world_free(&b);
+    /* the intact bytes (checksum recomputed: unchanged) load to the same world, which steps */
+    memcpy(copy, bytes, n);
+    hs_rehash(copy, n);
+    CHECK(memcmp(copy, bytes, n) == 0);
+    CHECK_EQ_INT(sph_world_load_mem(&b, copy, n, NULL), SPH_OK);
+    CHECK_EQ_INT(b.n, a.n);
+    CHECK_EQ_INT(sph_step(&b, sph_stable_dt(&b, SPH_SOLVER_WCSPH)), SPH_OK);
+    sph_world_free(&b);
+    TH_NOTE("%d edited files refused with the field named", cases);
+    free(bytes);
+    free(copy);
+    sph_world_free(&a);
+}
+
+/* ---- coordinates far from the origin ------------------------------------------------------- */
+
+static double hs_far_limit(double dx) { return dx / (1000 * TH_EPS); }
+
+/* A tank at rest 2D, 30 x 20 particles at dx = 0.02, at x = x0, for 1 s of WCSPH: the fluid
+   particles that left the walls (beyond the box the water filled). */
+static size_t hs_tank_lost(double x0, sph_status* status) {
+    sph_world_def d = sph_world_def_default(2);
+    sph_world w;
+    sph_phase water;
+    sph_real lo[2], hi[2], whi[2];
+    size_t i, lost = 0;
+    sph_status s;
+    memset(&water, 0, sizeof water);
+    water.rest_density = 1000;
+    d.spacing = (sph_real)0.02;
+    lo[0] = (sph_real)x0;
+    lo[1] = 0;
+    hi[0] = (sph_real)(x0 + 0.6);
+    hi[1] = (sph_real)0.4;
+    whi[0] = hi[0];
+    whi[1] = (sph_real)0.6;
+    s = sph_world_init(&w, &d);
+    if (s == SPH_OK && sph_world_add_phase(&w, &water) < 0) s = w.status;
+    if (s == SPH_OK) s = sph_fill_box(&w, 0, lo, hi);
+    if (s == SPH_OK) s = sph_add_wall_box(&w, lo, whi, 0, SPH_FACE_YMAX);
+    if (s == SPH_OK) s = sph_set_hydrostatic(&w);
+    if (s == SPH_OK) s = sph_advance(&w, 1);
+    for (i = 0; i < w.n; ++i) {
+        const double x = (double)w.x[2 * i], y = (double)w.x[2 * i + 1];
+        if (x < (double)lo[0] || x > (double)hi[0] || y < 0) ++lost;
+    }
+    *status = s;
+    sph_world_free(&w);
+    return lost;
+}
+
+/* At 0.95 of the documented limit (|x| eps <= dx / 1000: 159 m in float, 8.6e10 m in double at
+   dx = 0.02) the tank at rest keeps every particle for 1 s; at twice the limit it is refused.
+   Before the check the float tank at x = 1e4 m lost 308 of 600 particles, every call SPH_OK. */
+static void test_far_tank(void) {
+    const double lim = hs_far_limit(0.02);
+    sph_status s;
+    size_t lost = hs_tank_lost(0.95 * lim, &s);
+    CHECK_EQ_INT(s, SPH_OK);
+    CHECK_EQ_INT(lost, 0);
+    TH_NOTE("tank at x = %.4g m (0.95 of the limit): %zu of 600 left the walls in 1 s", 0.95 * lim,
+            lost);
+    lost = hs_tank_lost(2 * lim, &s);
+    CHECK_EQ_INT(s, SPH_ERR_ARG);
+}
+
+/* Every way positions enter is checked at twice the limit: the domain box at init, sph_fill_box,
+   sph_add_fluid(_ex) and sph_add_boundary (naming the particle), sph_add_wall_box (its outer
+   layer), the host writing a position between steps (the step changes nothing), and the loader.
+   Each message names the remedy. */
+static void test_far_coordinates_rejected(void) {
+    const double dx = 0.02, far = 2 * hs_far_limit(dx);
+    sph_world_def d = sph_world_def_default(2);
+    sph_world w, b;
+    sph_phase water;
+    sph_real x[8], lo[2], hi[2];
+    size_t i;
+    int k;
+    memset(&water, 0, sizeof water);
+    water.rest_density = 1000;
+    d.spacing = (sph_real)dx;
+    d.domain_lo[0] = 0;
+    d.domain_hi[0] = (sph_real)far;
+    CHECK_EQ_INT(sph_world_init(&w, &d), SPH_ERR_ARG);
+    CHECK_MSG(strstr(w.error, "domain_hi[0]") && strstr(w.error, "near the origin"), "%s", w.error);
+    sph_world_free(&w);
+    d.domain_hi[0] = 0;
+    CHECK_EQ_INT(sph_world_init(&w, &d), SPH_OK);
+    CHECK_EQ_INT(sph_world_add_phase(&w, &water), 0);
+    lo[0] = (sph_real)far;
+    lo[1] = 0;
+    hi[0] = (sph_real)(far + 0.2);
+    hi[1] = (sph_real)0.2;
+    CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_ERR_ARG);
+    CHECK_MSG(strstr(w.error, "sph_fill_box") && strstr(w.error, "too far"), "%s", w.error);
+    if (sizeof(sph_real) == 4) CHECK(strstr(w.error, "build in double") != NULL);
+    for (i = 0; i < 4; ++i) { x[2 * i] = (sph_real)(0.02 * (double)i); x[2 * i + 1] = 0; }
+    x[2 * 3 + 1] = (sph_real)-far;
+    CHECK_EQ_INT(sph_add_fluid(&w, 0, 4, x, NULL), SPH_ERR_ARG);
+    CHECK_EQ_INT(w.error_index, 3);
+    CHECK_MSG(strstr(w.error, "particle 3 at x[1]") && strstr(w.error, "near the origin"), "%s",
+              w.error);
+    CHECK_EQ_INT(sph_add_fluid_ex(&w, 0, 4, x, NULL, NULL, NULL), SPH_ERR_ARG);
+    CHECK_EQ_INT(sph_add_boundary(&w, 4, x, NULL, 0), SPH_ERR_ARG);
+    CHECK_EQ_INT(w.error_index, 3);
+    CHECK_EQ_INT(w.n + w.nb, 0);
+    /* a wall box inside the limit whose layers reach beyond it */
+    lo[0] = (sph_real)(far / 2 - 0.03);
+    hi[0] = (sph_real)(far / 2 - 0.01);
+    CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 3, 0), SPH_ERR_ARG);
+    CHECK_MSG(strstr(w.error, "outer layer"), "%s", w.error);
+    CHECK_EQ_INT(w.nb, 0);
+    /* the host writes a far position between steps: refused, nothing changed */
+    lo[0] = 0;
+    hi[0] = (sph_real)0.2;
+    CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
+    CHECK_EQ_INT(sph_step(&w, (sph_real)1e-4), SPH_OK);
+    for (k = 0; k < 2; ++k) {
+        const sph_real keep = w.x[2 * 5];
+        const uint64_t steps = w.steps;
+        w.x[2 * 5] = (sph_real)(k ? far : -far);
+        CHECK_EQ_INT(sph_step(&w, (sph_real)1e-4), SPH_ERR_ARG);
+        CHECK_EQ_INT(w.error_index, 5);
+        CHECK_MSG(strstr(w.error, "fluid particle 5") && strstr(w.error, "too far"), "%s", w.error);
+        CHECK_EQ_INT(w.steps, steps);
+        /* the loader refuses it too */
+        {
+            const size_t n = sph_world_save_mem(&w, NULL, 0);
+            unsigned char* buf = (unsigned char*)malloc(n);
+            sph_world_save_mem(&w, buf, n);
+            CHECK_EQ_INT(sph_world_load_mem(&b, buf, n, NULL), SPH_ERR_ARG);
+            CHECK_MSG(strstr(b.error, "sph_world_load") && strstr(b.error, "too far"), "%s", b.error);
+            sph_world_free(&b);
+            free(buf);
+        }
+        w.x[2 * 5] = keep;
+    }
+    CHECK_EQ_INT(sph_step(&w, (sph_real)1e-4), SPH_OK);
     sph_world_free(&w);
 }
 
 const th_test tests_hostile[] = {
     {"hostile/wall_box_matches_lattice_walk", test_wall_box_matches_lattice_walk},
     {"hostile/wall_box_cost_follows_surface", test_wall_box_cost_follows_surface},
+    {"hostile/load_checks_every_field", test_load_checks_fields},
+    {"hostile/far_tank_stays_in_walls_at_the_limit", test_far_tank},
+    {"hostile/far_coordinates_rejected", test_far_coordinates_rejected},
     {0, 0},
 };
