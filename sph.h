@@ -76,6 +76,12 @@ int main(void) {
    the resolution and, with h_factor, the smoothing length h = h_factor * dx; the kernel support
    is 2h or 3h. A particle has mass rest_density * dx^dim (its cell volume if sph_fill_box
    adjusted the spacing to fit a box), unless sph_phase.mass says otherwise.
+   Coordinates must resolve the spacing: a position carries |x| eps(sph_real) of rounding, which
+   the fluid feels as a disordered lattice, so every coordinate (domain box, added particles and
+   walls, positions written between steps, loaded files) must satisfy |x| eps <= dx / 1000, else
+   SPH_ERR_ARG: |x| <= 168 m at dx = 0.02 m in float (a float tank at rest kept every particle up
+   to 1.5 times that, and lost half of them at x = 1e4 m), 9e10 m in double. Place the scene
+   near the origin or build in double.
 
    KERNELS
    sph_kernel_init(&k, type, dim, h) then sph_kernel_w / _dwdr / _grad. Wendland C2 (default,
@@ -1042,7 +1048,9 @@ SPHDEF sph_status sph_write_vtk(const sph_world* w, const char* path);
    def, phase and stats structs) and a 64-bit FNV-1a checksum at the end: a file is read back by
    the same version of sph.h built with the same sph_real on a machine of the same byte order;
    anything else, a truncated file or a changed byte gives SPH_ERR_IO with the reason in
-   w->error. Callbacks are not saved: the loaders take force, force_user, boundary_motion and
+   w->error. Every loaded field is then checked with the rules of the API that sets it (def,
+   phases, particle positions, velocities, masses, densities, wall volumes, unique ids, a finite
+   time): a value the API would refuse gives SPH_ERR_ARG with that rule's message. Callbacks are not saved: the loaders take force, force_user, boundary_motion and
    boundary_user from `callbacks` (NULL: none). On failure a loader leaves w as after
    sph_world_free plus the message (safe to free again, nothing leaks). */
 SPHDEF sph_status sph_world_save(const sph_world* w, const char* path);
