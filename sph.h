@@ -79,8 +79,8 @@ int main(void) {
    Coordinates must resolve the spacing: a position carries |x| eps(sph_real) of rounding, which
    the fluid feels as a disordered lattice, so every coordinate (domain box, added particles and
    walls, positions written between steps, loaded files) must satisfy |x| eps <= dx / 1000, else
-   SPH_ERR_ARG: |x| <= 168 m at dx = 0.02 m in float (a float tank at rest kept every particle up
-   to 1.5 times that, and lost half of them at x = 1e4 m), 9e10 m in double. Place the scene
+   SPH_ERR_ARG: |x| <= 168 m at dx = 0.02 m in float (a float tank at rest there kept every
+   particle for 1 s up to x = 510 m, and lost half at x = 1e4 m), 9e10 m in double. Place the scene
    near the origin or build in double.
 
    KERNELS
