@@ -1418,11 +1418,29 @@ SPHDEF void sph_kernel_grad(const sph_kernel* k, const sph_real* xij, sph_real* 
 #define SPH__CELL_LIM 1048576
 #define SPH__CHUNK 256 /* query points per neighbour-list chunk */
 
+/* Offset of xk into the periodic box of direction k, in [0, len) up to rounding [m]. A point in
+   the box takes the plain difference (the arithmetic the world's wrapped positions always had);
+   one outside is wrapped first with fmod, which is exact, so that a point 2e12 boxes away lands
+   in the cell (and at the distance) its image in the box has: scaling by the cell factor
+   first, as before, put the rounding of 1e13 cells into the cell index. */
+SPH__INLINE double sph__periodic_offset(const sph_grid* g, int k, sph_real xk) {
+    double u;
+    if (xk >= g->lo[k] && xk < g->lo[k] + g->len[k]) return (double)(xk - g->lo[k]);
+    u = fmod((double)xk - (double)g->lo[k], (double)g->len[k]);
+    return u < 0 ? u + (double)g->len[k] : u;
+}
+
+/* xk moved into the periodic box of direction k (itself when it lies in the box). */
+SPH__INLINE sph_real sph__periodic_wrap(const sph_grid* g, int k, sph_real xk) {
+    if (xk >= g->lo[k] && xk < g->lo[k] + g->len[k]) return xk;
+    return (sph_real)((double)g->lo[k] + sph__periodic_offset(g, k, xk));
+}
+
 SPH__INLINE int32_t sph__cell_coord(const sph_grid* g, int k, sph_real xk) {
     double t;
     if (g->periodic[k]) {
         long long c;
-        t = floor((double)(xk - g->lo[k]) * g->inv[k]);
+        t = floor(sph__periodic_offset(g, k, xk) * g->inv[k]);
         if (!(t > -1e15)) t = 0; /* NaN or absurd: any cell; the distance test decides */
         if (t > 1e15) t = 0;
         c = (long long)t % (long long)g->ncell[k];
@@ -1473,8 +1491,11 @@ SPH__INLINE sph_real sph__wrap_delta(sph_real d, sph_real len) {
 SPHDEF void sph_grid_delta(const sph_grid* g, const sph_real* a, const sph_real* b, sph_real* d) {
     int k;
     for (k = 0; k < g->dim; ++k) {
-        d[k] = a[k] - b[k];
-        if (g->periodic[k]) d[k] = sph__wrap_delta(d[k], g->len[k]);
+        if (g->periodic[k])
+            d[k] = sph__wrap_delta(sph__periodic_wrap(g, k, a[k]) - sph__periodic_wrap(g, k, b[k]),
+                                   g->len[k]);
+        else
+            d[k] = a[k] - b[k];
     }
 }
 
@@ -1632,9 +1653,11 @@ SPHDEF sph_status sph_grid_build(sph_grid* g, const sph_real* x, size_t n) {
         const sph_real r2max_ = (radius) * (radius);                                               \
         int32_t c0_[3] = {0, 0, 0}, lo_[3] = {0, 0, 0}, hi_[3] = {0, 0, 0};                        \
         int32_t cc_[3] = {0, 0, 0};                                                                \
+        sph_real pw_[3] = {0, 0, 0}; /* p, wrapped into the periodic box */                        \
         int k_;                                                                                    \
         for (k_ = 0; k_ < dim_; ++k_) {                                                            \
             c0_[k_] = sph__cell_coord((g), k_, (p)[k_]);                                           \
+            pw_[k_] = (g)->periodic[k_] ? sph__periodic_wrap((g), k_, (p)[k_]) : (p)[k_];          \
             if ((g)->periodic[k_] && (g)->ncell[k_] == 2) { lo_[k_] = 0; hi_[k_] = 1; }            \
             else { lo_[k_] = -1; hi_[k_] = 1; }                                                    \
         }                                                                                          \
@@ -1665,8 +1688,11 @@ SPHDEF sph_status sph_grid_build(sph_grid* g, const sph_real* x, size_t n) {
                 sph_real d_[3] = {0, 0, 0}, r2_ = 0;                                               \
                 if ((g)->hashed && (g)->key[q_] != key_) continue;                                 \
                 for (k_ = 0; k_ < dim_; ++k_) {                                                    \
-                    d_[k_] = (p)[k_] - xj_[k_];                                                    \
-                    if ((g)->periodic[k_]) d_[k_] = sph__wrap_delta(d_[k_], (g)->len[k_]);        \
+                    if ((g)->periodic[k_])                                                         \
+                        d_[k_] = sph__wrap_delta(pw_[k_] - sph__periodic_wrap((g), k_, xj_[k_]),   \
+                                                 (g)->len[k_]);                                    \
+                    else                                                                           \
+                        d_[k_] = (p)[k_] - xj_[k_];                                                \
                     r2_ += d_[k_] * d_[k_];                                                        \
                 }                                                                                  \
                 if (r2_ < r2max_) { EMIT(j_, d_, r2_); }                                           \

@@ -513,11 +513,115 @@ static void test_far_coordinates_rejected(void) {
     sph_world_free(&w);
 }
 
+
+/* ---- periodic grids with points far outside the box ---------------------------------------- */
+
+/* The exact image of x in the periodic box [lo, lo + len) (fmod is exact). */
+static double hs_image(double x, double lo, double len) {
+    double u = fmod(x - lo, len);
+    return lo + (u < 0 ? u + len : u);
+}
+
+/* Issue 19's case (double: 0.55 + 2e12 and + 3e11 keep their fraction to 2.4e-4), then random
+   points in 1D, 2D and 3D, some moved by 12345 to 2e12 box lengths (either sign), against brute
+   force over their exact images with the minimum image: the grid's query, its neighbour lists
+   and sph_grid_delta. Pairs within 1e-4 of the radius are not compared (the stored point is
+   rounded). */
+static void test_periodic_grid_far_points(void) {
+    static const double shift[] = {0, 0, 12345, 3e11, -7e11, 2e12};
+    sph_real lo[3] = {0, -0.3f, 0.25f}, hi[3] = {1, 0.9f, 1.25f};
+    int per[3] = {1, 1, 1}, dim, missing = 0, extra = 0, compared = 0;
+    if (sizeof(sph_real) == 8) {
+        sph_grid g;
+        sph_real x[4];
+        uint32_t out[4];
+        int c;
+        x[0] = (sph_real)0.5;
+        x[1] = (sph_real)(0.55 + 2e12);
+        x[2] = (sph_real)0.45;
+        x[3] = (sph_real)(0.55 + 3e11);
+        CHECK_EQ_INT(sph_grid_init(&g, 1, (sph_real)0.2, per, lo, hi), SPH_OK);
+        CHECK_EQ_INT(sph_grid_build(&g, x, 4), SPH_OK);
+        for (c = 1; c <= 3; c += 2) {
+            size_t found = sph_grid_query(&g, x, &x[c], (sph_real)0.2, out, 4), q;
+            int has0 = 0;
+            sph_real d;
+            for (q = 0; q < found && q < 4; ++q) has0 |= out[q] == 0;
+            CHECK_MSG(has0, "the point at 0.55 + %g does not find its neighbour at 0.5",
+                      c == 1 ? 2e12 : 3e11);
+            sph_grid_delta(&g, &x[c], &x[0], &d);
+            CHECK_NEAR(d, 0.05, 1e-3);
+        }
+        sph_grid_free(&g);
+    }
+    for (dim = 1; dim <= 3; ++dim) {
+        const size_t n = dim == 1 ? 60 : dim == 2 ? 300 : 800;
+        const sph_real radius = (sph_real)0.2;
+        sph_real* x = (sph_real*)malloc(n * (size_t)dim * sizeof(sph_real));
+        double* img = (double*)malloc(n * (size_t)dim * sizeof(double));
+        uint32_t* out = (uint32_t*)malloc(n * sizeof(uint32_t));
+        sph_neighbors nl;
+        sph_grid g;
+        unsigned long r = 12345u + (unsigned long)dim;
+        size_t i, j;
+        int k;
+        memset(&nl, 0, sizeof nl);
+        for (i = 0; i < n * (size_t)dim; ++i) {
+            const int kk = (int)(i % (size_t)dim);
+            const double len = (double)(hi[kk] - lo[kk]);
+            double u, s;
+            r = r * 6364136223846793005ul + 1442695040888963407ul;
+            u = (double)((r >> 11) & 0xfffff) / 1048576.0;
+            s = shift[(r >> 40) % 6];
+            x[i] = (sph_real)((double)lo[kk] + u * len + ((r >> 50) & 1 ? s : -s) * len);
+            img[i] = hs_image((double)x[i], (double)lo[kk], len);
+        }
+        CHECK_EQ_INT(sph_grid_init(&g, dim, radius, per, lo, hi), SPH_OK);
+        CHECK_EQ_INT(sph_grid_build(&g, x, n), SPH_OK);
+        CHECK_EQ_INT(sph_neighbors_build(&nl, &g, x, x, n, radius, 1), SPH_OK);
+        for (i = 0; i < n; ++i) {
+            const size_t found = sph_grid_query(&g, x, x + i * (size_t)dim, radius, out, n);
+            for (j = 0; j < n; ++j) {
+                double r2 = 0, rr;
+                int in_query = 0, in_list = 0;
+                size_t q;
+                sph_real d[3];
+                for (k = 0; k < dim; ++k) {
+                    const double len = (double)(hi[k] - lo[k]);
+                    double dd = img[i * (size_t)dim + (size_t)k] - img[j * (size_t)dim + (size_t)k];
+                    dd -= len * floor(dd / len + 0.5);
+                    r2 += dd * dd;
+                }
+                rr = sqrt(r2);
+                if (fabs(rr - (double)radius) < 1e-4) continue;
+                ++compared;
+                for (q = 0; q < found && q < n; ++q) in_query |= out[q] == (uint32_t)j;
+                for (q = 0; q < nl.count[i]; ++q) in_list |= nl.idx[nl.begin[i] + q] == (uint32_t)j;
+                if (rr < (double)radius && (!in_query || (i != j && !in_list))) ++missing;
+                if (rr >= (double)radius && (in_query || in_list)) ++extra;
+                sph_grid_delta(&g, x + i * (size_t)dim, x + j * (size_t)dim, d);
+                r2 = 0;
+                for (k = 0; k < dim; ++k) r2 += (double)d[k] * (double)d[k];
+                if (fabs(sqrt(r2) - rr) > 1e-4) ++extra;
+            }
+        }
+        sph_neighbors_free(&nl);
+        sph_grid_free(&g);
+        free(x);
+        free(img);
+        free(out);
+    }
+    CHECK_EQ_INT(missing, 0);
+    CHECK_EQ_INT(extra, 0);
+    TH_NOTE("%d pairs against brute force: %d missing, %d wrong", compared, missing, extra);
+}
+
 const th_test tests_hostile[] = {
     {"hostile/wall_box_matches_lattice_walk", test_wall_box_matches_lattice_walk},
     {"hostile/wall_box_cost_follows_surface", test_wall_box_cost_follows_surface},
     {"hostile/load_checks_every_field", test_load_checks_fields},
     {"hostile/far_tank_stays_in_walls_at_the_limit", test_far_tank},
     {"hostile/far_coordinates_rejected", test_far_coordinates_rejected},
+    {"hostile/periodic_grid_far_points", test_periodic_grid_far_points},
     {0, 0},
 };
