@@ -3944,12 +3944,21 @@ static void sph__stage_interact(sph_world* w, const sph__ctx* c, int flags, sph_
 }
 
 /* Body accelerations: gravity plus the user's force callback, per block of particles. They start
-   the acceleration array; the wall extrapolation reads them, the neighbour pass adds to them. */
-static void sph__stage_body_force(sph_world* w, const sph__ctx* c) {
+   the acceleration array; the wall extrapolation reads them, the neighbour pass adds to them.
+   The callback's output is checked right after each call, over the range it just wrote (cached,
+   a few ns per particle): a non-finite value spreads to the neighbours within the step, and the
+   end-of-step check would name the lowest index it reached instead of the particle where it
+   entered. The lowest bad index over all blocks is a min-reduction, the same for any number of
+   threads. SPH_ERR_UNSTABLE (the step has already sorted, and maybe drifted, the particles). */
+static sph_status sph__stage_body_force(sph_world* w, const sph__ctx* c) {
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
     const int D = c->dim;
-    sph__idx blk;
-    SPH__OMP_FOR(w->n) /* over blocks of SPH__BLOCK particles */
+    sph__idx blk, bad = (sph__idx)w->n;
+#if defined(_OPENMP) && _OPENMP >= 201107
+#pragma omp parallel for schedule(static) if (w->n > 2048) reduction(min : bad)
+#else
+    SPH__OMP_FOR(w->n) /* (OpenMP before 3.1 has no min-reduction: the check below is serial) */
+#endif
     for (blk = 0; blk < (sph__idx)nblk; ++blk) {
         const size_t i0 = (size_t)blk * SPH__BLOCK;
         const size_t i1 = i0 + SPH__BLOCK < w->n ? i0 + SPH__BLOCK : w->n;
@@ -3957,8 +3966,34 @@ static void sph__stage_body_force(sph_world* w, const sph__ctx* c) {
         int k;
         for (i = i0; i < i1; ++i)
             for (k = 0; k < D; ++k) w->a[i * (size_t)D + (size_t)k] = c->g[k];
-        if (w->def.force) w->def.force(w, i0, i1, w->a, w->def.force_user);
+        if (!w->def.force) continue;
+        w->def.force(w, i0, i1, w->a, w->def.force_user);
+#if defined(_OPENMP) && _OPENMP >= 201107
+        for (i = i0; i < i1 && (sph__idx)i < bad; ++i)
+            for (k = 0; k < D; ++k)
+                if (!sph__finite((double)w->a[i * (size_t)D + (size_t)k])) bad = (sph__idx)i;
+#endif
     }
+#if !(defined(_OPENMP) && _OPENMP >= 201107)
+    if (w->def.force) {
+        size_t i;
+        int k;
+        for (i = 0; i < w->n && (sph__idx)i < bad; ++i)
+            for (k = 0; k < D; ++k)
+                if (!sph__finite((double)w->a[i * (size_t)D + (size_t)k])) bad = (sph__idx)i;
+    }
+#endif
+    if (bad < (sph__idx)w->n) {
+        const size_t i = (size_t)bad;
+        int k = 0;
+        while (k < D - 1 && sph__finite((double)w->a[i * (size_t)D + (size_t)k])) ++k;
+        return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
+                         "force callback: it produced a non-finite acceleration a[%d] = %g for "
+                         "fluid particle %zu (id %u) at t = %g",
+                         k, (double)w->a[i * (size_t)D + (size_t)k], i, (unsigned)w->id[i],
+                         w->time);
+    }
+    return SPH_OK;
 }
 
 /* Rejects a step on input that would poison it: dt, and non-finite positions, velocities or
@@ -4289,7 +4324,7 @@ static sph_status sph__prepare_forces(sph_world* w, sph__ctx* c, double t, doubl
     }
     sph__stage_eos(w, c);
     sph__time(w, SPH_STAGE_PRESSURE, t0);
-    sph__stage_body_force(w, c);
+    if ((s = sph__stage_body_force(w, c)) != SPH_OK) return s;
     sph__time(w, SPH_STAGE_FORCES, t0);
     if (w->nb > 0) sph__stage_wall(w, c, SPH__WALL_STATE | SPH__WALL_PRESSURE);
     sph__time(w, SPH_STAGE_PRESSURE, t0);
@@ -4434,7 +4469,7 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
     sph__time(w, SPH_STAGE_DENSITY, &t0);
     sph__stage_eos(w, &c);
     sph__time(w, SPH_STAGE_PRESSURE, &t0);
-    sph__stage_body_force(w, &c);
+    if ((s = sph__stage_body_force(w, &c)) != SPH_OK) return s;
     sph__time(w, SPH_STAGE_FORCES, &t0);
     if (w->nb > 0) sph__stage_wall(w, &c, SPH__WALL_STATE | SPH__WALL_PRESSURE);
     sph__time(w, SPH_STAGE_PRESSURE, &t0);
@@ -4689,7 +4724,7 @@ static sph_status sph__soc_rhs(sph_world* w, const sph__ctx* c, const sph__soc* 
     for (i = 0; i < (sph__idx)n; ++i) w->p[i] = sph__eos(&c->pc[w->phase[i]], w->rho[i]);
     sph__soc_grad(w, nl, w->p, 1, S->gp);
     sph__soc_div(w, nl, w->v, S->lap);
-    sph__stage_body_force(w, c); /* w->a = g + the user's forces */
+    if (sph__stage_body_force(w, c) != SPH_OK) return w->status; /* w->a = g + user forces */
     SPH__OMP_FOR(n)
     for (i = 0; i < (sph__idx)n; ++i) {
         const sph_real inv = 1 / w->rho[i];
@@ -5073,7 +5108,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
     sph__copy(w->priv.rho_n, w->rho, w->n * sizeof(sph_real));
     sph__time(w, SPH_STAGE_DENSITY, &t0);
     /* non-pressure accelerations a_np (kept in w->a) */
-    sph__stage_body_force(w, &c);
+    if ((s = sph__stage_body_force(w, &c)) != SPH_OK) return s;
     if (w->nb > 0) sph__stage_wall(w, &c, SPH__WALL_STATE);
     if (c.laminar || c.av) sph__stage_interact(w, &c, SPH__VISCOUS, w->a);
     sph__time(w, SPH_STAGE_FORCES, &t0);
@@ -5383,7 +5418,7 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
     sph__stage_density_summation(w, &c);
     sph__time(w, SPH_STAGE_DENSITY, &t0);
     /* non-pressure accelerations and the predicted velocity v* (kept in w->v) */
-    sph__stage_body_force(w, &c);
+    if ((s = sph__stage_body_force(w, &c)) != SPH_OK) return s;
     if (w->nb > 0) sph__stage_wall(w, &c, SPH__WALL_STATE);
     if (c.laminar || c.av) sph__stage_interact(w, &c, SPH__VISCOUS, w->a);
     s = sph__integrate(w, &c, dt, 0, 0, 0);

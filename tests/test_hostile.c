@@ -616,6 +616,162 @@ static void test_periodic_grid_far_points(void) {
     TH_NOTE("%d pairs against brute force: %d missing, %d wrong", compared, missing, extra);
 }
 
+
+/* ---- the force callback named when it writes a non-finite value ---------------------------- */
+
+typedef struct hs_bad_force {
+    uint32_t ids[4]; /* the particles (by id) whose acceleration becomes NaN */
+    int count, armed;
+} hs_bad_force;
+
+static void hs_bad_force_fn(const sph_world* w, size_t begin, size_t end, sph_real* acc, void* user) {
+    const hs_bad_force* f = (const hs_bad_force*)user;
+    size_t i;
+    int q;
+    for (i = begin; i < end; ++i) {
+        acc[i * (size_t)w->dim] += (sph_real)0.1;
+        for (q = 0; f->armed && q < f->count; ++q)
+            if (w->id[i] == f->ids[q]) acc[i * (size_t)w->dim + (size_t)(q % w->dim)] = (sph_real)NAN;
+    }
+}
+
+/* 2D tank of 60 x 40 water particles (parallel loops above 2048) with walls, `solver`, the
+   force callback above; 3 clean steps, then the callback writes NaN for the listed ids. Returns
+   the failing step's status; *index the particle named. */
+static sph_status hs_force_run(int solver, int verlet, const hs_bad_force* bad_in, long* index,
+                               char* msg) {
+    sph_world_def d = sph_world_def_default(2);
+    sph_world w;
+    sph_phase water;
+    hs_bad_force bad = *bad_in;
+    sph_real lo[2] = {0, 0}, hi[2] = {1.2f, 0.8f}, whi[2] = {1.2f, 1.0f};
+    sph_status s = SPH_OK;
+    int q;
+    memset(&water, 0, sizeof water);
+    water.rest_density = 1000;
+    if (solver == SPH_SOLVER_PCISPH) sph_world_def_pcisph(&d, 1);
+    d.spacing = (sph_real)0.02;
+    d.solver = (sph_solver)solver;
+    if (verlet) d.integrator = SPH_INTEGRATOR_VERLET;
+    d.force = hs_bad_force_fn;
+    d.force_user = &bad;
+    bad.armed = 0;
+    if (sph_world_init(&w, &d) != SPH_OK || sph_world_add_phase(&w, &water) != 0 ||
+        sph_fill_box(&w, 0, lo, hi) != SPH_OK || sph_add_wall_box(&w, lo, whi, 0, SPH_FACE_YMAX) != SPH_OK ||
+        sph_set_hydrostatic(&w) != SPH_OK) {
+        CHECK_MSG(0, "setup: %s", w.error);
+        sph_world_free(&w);
+        return SPH_ERR_ARG;
+    }
+    for (q = 0; q < 4 && s == SPH_OK; ++q) {
+        bad.armed = q == 3;
+        s = sph_step(&w, sph_stable_dt(&w, (sph_solver)solver));
+        if (q < 3) CHECK_EQ_INT(s, SPH_OK);
+    }
+    *index = w.error_index;
+    memcpy(msg, w.error, SPH_ERROR_SIZE);
+    if (*index >= 0 && (size_t)*index < w.n) {
+        /* the named particle is one the callback poisoned, and the lowest such index */
+        size_t i, lowest = w.n;
+        for (i = 0; i < w.n && lowest == w.n; ++i)
+            for (q = 0; q < bad.count; ++q)
+                if (w.id[i] == bad.ids[q]) { lowest = i; break; }
+        CHECK_MSG((size_t)*index == lowest, "named particle %ld, the lowest poisoned index is %zu: %s",
+                  *index, lowest, w.error);
+    }
+    sph_world_free(&w);
+    return s;
+}
+
+/* A force callback that writes NaN for id 7 fails the step naming index and id 7 and the
+   callback, in WCSPH (Euler and Verlet), PCISPH, IISPH and the compressible step; with ids
+   2300, 7 and 1200 poisoned the lowest index among them is named, the same for 1 and 2 threads.
+   Before, the error named the lowest index the NaN had spread to (id 1 in the issue). */
+static void test_force_callback_culprit(void) {
+    static const int solvers[][2] = {{SPH_SOLVER_WCSPH, 0}, {SPH_SOLVER_WCSPH, 1},
+                                     {SPH_SOLVER_PCISPH, 1}, {SPH_SOLVER_IISPH, 0},
+                                     {SPH_SOLVER_COMPRESSIBLE, 0}};
+    hs_bad_force one, three;
+    char msg[SPH_ERROR_SIZE];
+    long index = -1, index1 = -1;
+    int q, threads;
+#ifdef _OPENMP
+    const int max_threads = omp_get_max_threads();
+#endif
+    memset(&one, 0, sizeof one);
+    one.ids[0] = 7;
+    one.count = 1;
+    memset(&three, 0, sizeof three);
+    three.ids[0] = 2300;
+    three.ids[1] = 7;
+    three.ids[2] = 1200;
+    three.count = 3;
+    for (q = 0; q < 5; ++q) {
+        const sph_status s = hs_force_run(solvers[q][0], solvers[q][1], &one, &index, msg);
+        CHECK_MSG(s == SPH_ERR_UNSTABLE, "solver %d: %s", solvers[q][0], msg);
+        CHECK_MSG(strstr(msg, "force callback") && strstr(msg, "(id 7)"), "solver %d: %s",
+                  solvers[q][0], msg);
+    }
+    TH_NOTE("%s", msg);
+#ifdef _OPENMP
+    for (threads = 1; threads <= 2; ++threads) {
+        omp_set_num_threads(threads);
+#else
+    for (threads = 1; threads <= 1; ++threads) {
+#endif
+        CHECK_EQ_INT(hs_force_run(SPH_SOLVER_WCSPH, 0, &three, &index, msg), SPH_ERR_UNSTABLE);
+        if (threads == 1) index1 = index;
+        CHECK_EQ_INT(index, index1);
+    }
+#ifdef _OPENMP
+    omp_set_num_threads(max_threads);
+#endif
+}
+
+typedef struct hs_bad_motion {
+    uint32_t id;
+    unsigned calls;
+} hs_bad_motion;
+
+static void hs_bad_motion_fn(sph_world* w, double time, void* user) {
+    hs_bad_motion* m = (hs_bad_motion*)user;
+    size_t b;
+    (void)time;
+    if (++m->calls < 3) return;
+    for (b = 0; b < w->nb; ++b)
+        if (w->b_id[b] == m->id) w->b_v[b * (size_t)w->dim + 1] = (sph_real)NAN;
+}
+
+/* The boundary-motion callback's output was already checked right after the call: the error
+   names the wall particle where the NaN was written (index and id 13). */
+static void test_motion_callback_culprit(void) {
+    sph_world_def d = sph_world_def_default(2);
+    sph_world w;
+    sph_phase water;
+    hs_bad_motion m;
+    sph_real lo[2] = {0, 0}, hi[2] = {0.4f, 0.2f}, whi[2] = {0.4f, 0.3f};
+    sph_status s = SPH_OK;
+    size_t b;
+    int q;
+    memset(&water, 0, sizeof water);
+    water.rest_density = 1000;
+    m.id = 13;
+    m.calls = 0;
+    d.spacing = (sph_real)0.02;
+    d.boundary_motion = hs_bad_motion_fn;
+    d.boundary_user = &m;
+    CHECK(sph_world_init(&w, &d) == SPH_OK && sph_world_add_phase(&w, &water) == 0 &&
+          sph_fill_box(&w, 0, lo, hi) == SPH_OK &&
+          sph_add_wall_box(&w, lo, whi, 0, SPH_FACE_YMAX) == SPH_OK);
+    for (q = 0; q < 3 && s == SPH_OK; ++q) s = sph_step(&w, (sph_real)1e-4);
+    CHECK_EQ_INT(s, SPH_ERR_ARG);
+    CHECK_MSG(strstr(w.error, "(id 13)") && strstr(w.error, "boundary motion callback"), "%s",
+              w.error);
+    for (b = 0; b < w.nb && w.b_id[b] != 13; ++b) {}
+    CHECK_EQ_INT(w.error_index, b);
+    sph_world_free(&w);
+}
+
 const th_test tests_hostile[] = {
     {"hostile/wall_box_matches_lattice_walk", test_wall_box_matches_lattice_walk},
     {"hostile/wall_box_cost_follows_surface", test_wall_box_cost_follows_surface},
@@ -623,5 +779,7 @@ const th_test tests_hostile[] = {
     {"hostile/far_tank_stays_in_walls_at_the_limit", test_far_tank},
     {"hostile/far_coordinates_rejected", test_far_coordinates_rejected},
     {"hostile/periodic_grid_far_points", test_periodic_grid_far_points},
+    {"hostile/force_callback_culprit_named", test_force_callback_culprit},
+    {"hostile/motion_callback_culprit_named", test_motion_callback_culprit},
     {0, 0},
 };
