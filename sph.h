@@ -2993,7 +2993,11 @@ SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_r
         }
     }
     SPH_ASSERT(nw == (size_t)(all - inner));
-    s = sph__append_boundary(w, nw, pts, vol, 0);
+    /* the rules of sph_add_boundary: a box far thinner than a spacing gives volumes that round
+       to 0 (a denormal spacing across it; found by tests/fuzz_api.c) */
+    s = sph__check_boundary(w, "sph_add_wall_box", nw, pts, vol, 0);
+    if (s != SPH_OK) w->error_index = -1; /* an index of the box's own list, not the caller's */
+    if (s == SPH_OK) s = sph__append_boundary(w, nw, pts, vol, 0);
 done:
     if (s == SPH_ERR_NOMEM) sph__fail(w, s, -1, "sph_add_wall_box: out of memory");
     for (k = 0; k < 3; ++k) { SPH_FREE(coord[k]); SPH_FREE(width[k]); SPH_FREE(side[k]); }

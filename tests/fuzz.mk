@@ -49,10 +49,12 @@ fuzz: | $(B)
 	    exit 0; \
 	fi; \
 	set -e; \
-	for h in world load api; do \
+	pids=; for h in world load api; do \
 	    echo "$(FUZZ_CC) -g -O1 -fsanitize=fuzzer,address,undefined ... tests/fuzz_$$h.c -o $(B)/fuzz_$$h"; \
-	    $(FUZZ_CC) -g -O1 -fsanitize=fuzzer $(FUZZ_SAN) $(FUZZ_DEFS) -I. tests/fuzz_$$h.c -lm -o $(B)/fuzz_$$h; \
+	    $(FUZZ_CC) -g -O1 -fsanitize=fuzzer $(FUZZ_SAN) $(FUZZ_DEFS) -I. tests/fuzz_$$h.c -lm -o $(B)/fuzz_$$h & \
+	    pids="$$pids $$!"; \
 	done; \
+	for p in $$pids; do wait $$p; done; \
 	mkdir -p $(B)/fuzz_corpus $(B)/fuzz_corpus_load $(B)/fuzz_corpus_api $(B)/fuzz_artifacts; \
 	./$(B)/fuzz_world $(B)/fuzz_corpus tests/fuzz_corpus \
 	    -max_total_time=$$(( $(FUZZ_TIME) / 2 )) -artifact_prefix=$(B)/fuzz_artifacts/ $(FUZZ_FLAGS); \

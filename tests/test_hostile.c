@@ -216,6 +216,23 @@ static void test_wall_box_cost_follows_surface(void) {
     sph_world_free(&w);
 }
 
+/* A box a denormal wide gives wall volumes that round to 0, which sph_add_boundary refuses:
+   sph_add_wall_box refuses them too now (SPH_ERR_ARG, nothing added; the saved world would not
+   load). Found by tests/fuzz_api.c. */
+static void test_wall_box_zero_volume(void) {
+    sph_world_def d = sph_world_def_default(2);
+    sph_world w;
+    sph_real lo[2] = {0, 0}, hi[2] = {0.2f, 0};
+    hi[1] = (sph_real)(sizeof(sph_real) == 4 ? 1.4e-45 : 4.9e-324); /* the smallest denormal */
+    d.spacing = (sph_real)0.02;
+    CHECK_EQ_INT(sph_world_init(&w, &d), SPH_OK);
+    CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 2, 0), SPH_ERR_ARG);
+    CHECK_MSG(strstr(w.error, "vol of particle") != NULL, "%s", w.error);
+    CHECK_EQ_INT(w.nb, 0);
+    CHECK_EQ_INT(w.error_index, -1);
+    sph_world_free(&w);
+}
+
 /* ---- loaded files are checked like the API's input -------------------------------------------- */
 
 /* A small tank: 2D water 10 x 8 at dx = 0.02 in walls, 5 WCSPH steps taken. */
@@ -775,6 +792,7 @@ static void test_motion_callback_culprit(void) {
 const th_test tests_hostile[] = {
     {"hostile/wall_box_matches_lattice_walk", test_wall_box_matches_lattice_walk},
     {"hostile/wall_box_cost_follows_surface", test_wall_box_cost_follows_surface},
+    {"hostile/wall_box_zero_volume_refused", test_wall_box_zero_volume},
     {"hostile/load_checks_every_field", test_load_checks_fields},
     {"hostile/far_tank_stays_in_walls_at_the_limit", test_far_tank},
     {"hostile/far_coordinates_rejected", test_far_coordinates_rejected},
