@@ -1050,7 +1050,8 @@ SPHDEF sph_status sph_write_vtk(const sph_world* w, const char* path);
    anything else, a truncated file or a changed byte gives SPH_ERR_IO with the reason in
    w->error. Every loaded field is then checked with the rules of the API that sets it (def,
    phases, particle positions, velocities, masses, densities, wall volumes, unique ids, a finite
-   time): a value the API would refuse gives SPH_ERR_ARG with that rule's message. Callbacks are not saved: the loaders take force, force_user, boundary_motion and
+   time): a value the API would refuse gives SPH_ERR_ARG with that rule's message. Callbacks
+   are not saved: the loaders take force, force_user, boundary_motion and
    boundary_user from `callbacks` (NULL: none). On failure a loader leaves w as after
    sph_world_free plus the message (safe to free again, nothing leaks). */
 SPHDEF sph_status sph_world_save(const sph_world* w, const char* path);
@@ -2335,7 +2336,8 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
             char what[64];
             const int hi = fabs((double)d->domain_hi[k]) > sph__far_limit(d->spacing);
             snprintf(what, sizeof what, "sph_world_def.domain_%s[%d]", hi ? "hi" : "lo", k);
-            return sph__fail_far(w, d->spacing, -1, what, (double)(hi ? d->domain_hi[k] : d->domain_lo[k]));
+            return sph__fail_far(w, d->spacing, -1, what,
+                                 (double)(hi ? d->domain_hi[k] : d->domain_lo[k]));
         }
     }
     return SPH_OK;
@@ -2918,7 +2920,8 @@ SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_r
         double span = (double)((hi[k] - lo[k]) / w->dx), ni;
         /* before the conversion: a span beyond size_t (or hi - lo overflowing to inf) would make
            it undefined */
-        if (!(span <= 1e7)) return sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_add_wall_box: box too large");
+        if (!(span <= 1e7))
+            return sph__fail(w, SPH_ERR_CAPACITY, -1, "sph_add_wall_box: box too large");
         ni = floor(span + 0.5);
         if (ni < 1) ni = 1;
         inner *= ni;
@@ -4085,8 +4088,9 @@ static sph_status sph__boundary_motion(sph_world* w, double t) {
     i = sph__first_far(w->b_x, w->nb * D, sph__far_limit(w->dx));
     if (i < w->nb * D) {
         char what[128];
-        snprintf(what, sizeof what, "boundary motion callback: boundary particle %zu (id %u) at x[%zu]",
-                 i / D, (unsigned)w->b_id[i / D], i % D);
+        snprintf(what, sizeof what,
+                 "boundary motion callback: boundary particle %zu (id %u) at x[%zu]", i / D,
+                 (unsigned)w->b_id[i / D], i % D);
         return sph__fail_far(w, w->dx, (long)(i / D), what, (double)w->b_x[i]);
     }
     return SPH_OK;
@@ -6145,8 +6149,8 @@ static sph_status sph__check_ids(sph_world* w, const char* what, const uint32_t*
         SPH_FREE(sorted);
         for (i = 0; id[i] != dup; ++i) {}
         return sph__fail(w, SPH_ERR_ARG, (long)i,
-                         "sph_world_load: %s particle %zu has id %u, which another particle has too",
-                         what, i, (unsigned)dup);
+                         "sph_world_load: %s particle %zu has id %u, which another particle "
+                         "has too", what, i, (unsigned)dup);
     }
     SPH_FREE(sorted);
     return SPH_OK;

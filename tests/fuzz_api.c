@@ -86,12 +86,15 @@ static void fza_points(fza_ctx* c, size_t n, sph_real* x) {
     double base[3];
     size_t side = 1, i;
     int k;
-    for (k = 0; k < 3; ++k) base[k] = fzc_real(&c->r, 0, -20 * dx, 20 * dx);
-    while (dim == 1 ? side < n : dim == 2 ? side * side < n : side * side * side < n) ++side;
+    for (k = 0; k < 3; ++k)
+        base[k] = fzc_real(&c->r, 0, -20 * dx, 20 * dx);
+    while (dim == 1 ? side < n : dim == 2 ? side * side < n : side * side * side < n)
+        ++side;
     for (i = 0; i < n; ++i) {
         size_t rem = i;
         for (k = 0; k < dim; ++k) {
-            x[i * (size_t)dim + (size_t)k] = (sph_real)(base[k] + ((double)(rem % side) + 0.5) * dx);
+            x[i * (size_t)dim + (size_t)k] =
+                (sph_real)(base[k] + ((double)(rem % side) + 0.5) * dx);
             rem /= side;
         }
     }
@@ -159,8 +162,10 @@ static void fza_step(fza_ctx* c, unsigned op) {
         double dur = isfinite(f) && f > 0 ? (f < 3 ? 2 * f : 4) * (double)dt : f;
         s = sph_advance(w, (sph_real)dur);
     } else {
-        if (!(isfinite(f) && f > 0 && f <= 2)) dt = (sph_real)f; /* 0, negative, NaN, huge ... */
-        else dt = (sph_real)((double)dt * f);
+        if (!(isfinite(f) && f > 0 && f <= 2))
+            dt = (sph_real)f; /* 0, negative, NaN, huge ... */
+        else
+            dt = (sph_real)((double)dt * f);
         s = sph_step(w, dt);
     }
     fzc_after(what, w, s, &before, 0);
@@ -224,8 +229,10 @@ static void fza_call(fza_ctx* c) {
         vv = fzc_real(r, 0, -2, 2);
         mm = fzc_real(r, 1, 0.1, 3);
         rr = fzc_real(r, 1000, 1, 3000);
-        for (i = 0; i < n * (size_t)dim; ++i) a[i] = (sph_real)vv;
-        for (i = 0; i < n; ++i) m[i] = (sph_real)(op == 4 ? mm * pow((double)w->dx, dim) : mm);
+        for (i = 0; i < n * (size_t)dim; ++i)
+            a[i] = (sph_real)vv;
+        for (i = 0; i < n; ++i)
+            m[i] = (sph_real)(op == 4 ? mm * pow((double)w->dx, dim) : mm);
         if (op == 4) {
             if ((double)(w->nb + n) > FZA_MAX_WALL) goto skip;
             s = sph_add_boundary(w, n, (flags & 8u) ? NULL : x, (flags & 1u) ? m : NULL,
@@ -274,10 +281,14 @@ static void fza_call(fza_ctx* c) {
         const unsigned which = fzc_u8(r) % 4u, idx = fzc_u16(r), comp = fzc_u8(r);
         const double v = fzc_real(r, 0, -1, 1);
         if (w->n == 0) return;
-        if (which == 0) w->x[(idx % w->n) * (size_t)dim + comp % (unsigned)dim] = (sph_real)v;
-        else if (which == 1) w->v[(idx % w->n) * (size_t)dim + comp % (unsigned)dim] = (sph_real)v;
-        else if (which == 2) w->rho[idx % w->n] = (sph_real)v;
-        else if (w->e) w->e[idx % w->n] = (sph_real)v;
+        if (which == 0)
+            w->x[(idx % w->n) * (size_t)dim + comp % (unsigned)dim] = (sph_real)v;
+        else if (which == 1)
+            w->v[(idx % w->n) * (size_t)dim + comp % (unsigned)dim] = (sph_real)v;
+        else if (which == 2)
+            w->rho[idx % w->n] = (sph_real)v;
+        else if (w->e)
+            w->e[idx % w->n] = (sph_real)v;
         FZC_LOG("  host writes %u[%u] = %g\n", which, idx % (unsigned)w->n, v);
         c->dirty = 1;
         /* what the host wrote must not hide from the loader: a loaded copy of it either loads
@@ -317,7 +328,10 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     d.solver = (sph_solver)((b >> 1) % 4u);
     b = fzc_u8(&c->r);
     d.integrator = (sph_integrator)(b & 1u);
-    if (b & 2u) { d.force = fza_force_fn; d.force_user = &c->force; }
+    if (b & 2u) {
+        d.force = fza_force_fn;
+        d.force_user = &c->force;
+    }
     if (b & 4u) d.density = SPH_DENSITY_SUMMATION;
     d.spacing = (sph_real)fzc_real(&c->r, 0.02, 0.005, 0.1);
     d.max_iterations = 30;
@@ -329,7 +343,8 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         return 0;
     }
     calls = 1 + fzc_u8(&c->r) % 24u;
-    for (q = 0; q < calls; ++q) fza_call(c);
+    for (q = 0; q < calls; ++q)
+        fza_call(c);
     sph_world_free(&c->w);
     FZC_ASSERT(c->w.n == 0 && c->w.x == NULL, "sph_world_free left particles");
     free(c);

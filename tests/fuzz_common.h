@@ -37,9 +37,10 @@ static unsigned fzc_u16(fzc_reader* r) {
 static double fzc_real(fzc_reader* r, double def, double lo, double hi) {
     const unsigned mode = fzc_u8(r), a = fzc_u8(r), b = fzc_u8(r);
     static const double special[32] = {
-        0, -1, NAN, INFINITY, -INFINITY, 1e300, -1e300, 1e-300, 4.9e-324, 1e30, -1e30, 1e4,
-        -1e4, 1e5, 3e11, 0.55 + 2e12, 3.5e38, -0.0, 1e-7, 1e6, 2147483648.0, 1e-45, 1e-40,
-        -5, -3, -1e9, 1e15, 0.5, 1e-3, 100, 170, 336};
+        0,        -1,   NAN,   INFINITY, -INFINITY,    1e300, -1e300, 1e-300,
+        4.9e-324, 1e30, -1e30, 1e4,      -1e4,         1e5,   3e11,   0.55 + 2e12,
+        3.5e38,   -0.0, 1e-7,  1e6,      2147483648.0, 1e-45, 1e-40,  -5,
+        -3,       -1e9, 1e15,  0.5,      1e-3,         100,   170,    336};
     if (mode < 128) return def;
     if (mode < 224) return lo + (hi - lo) * (double)((a << 8) | b) / 65535.0;
     return special[(mode - 224) & 31u];
@@ -48,7 +49,7 @@ static double fzc_real(fzc_reader* r, double def, double lo, double hi) {
 #define FZC_ASSERT(cond, ...)                                                                      \
     do {                                                                                           \
         if (!(cond)) {                                                                             \
-            fprintf(stderr, "%s: invariant violated at line %d: %s\n  ", __FILE__, __LINE__,      \
+            fprintf(stderr, "%s: invariant violated at line %d: %s\n  ", __FILE__, __LINE__,       \
                     #cond);                                                                        \
             fprintf(stderr, __VA_ARGS__);                                                          \
             fputc('\n', stderr);                                                                   \
@@ -57,13 +58,19 @@ static double fzc_real(fzc_reader* r, double def, double lo, double hi) {
     } while (0)
 
 static int fzc_verbose = -1;
-#define FZC_LOG(...) do { if (fzc_verbose > 0) fprintf(stderr, __VA_ARGS__); } while (0)
+#define FZC_LOG(...)                                                                               \
+    do {                                                                                           \
+        if (fzc_verbose > 0) fprintf(stderr, __VA_ARGS__);                                         \
+    } while (0)
 
 static uint64_t fzc_hash(uint64_t h, const void* data, size_t bytes) {
     const unsigned char* c = (const unsigned char*)data;
     size_t i;
     if (!data) return h ^ 0x9e3779b97f4a7c15ULL;
-    for (i = 0; i < bytes; ++i) { h ^= c[i]; h *= 1099511628211ULL; }
+    for (i = 0; i < bytes; ++i) {
+        h ^= c[i];
+        h *= 1099511628211ULL;
+    }
     return h;
 }
 

@@ -41,7 +41,10 @@ static sph_status fzl_scene(sph_world* w, unsigned which, unsigned steps) {
     b.rest_density = 500;
     d.spacing = (sph_real)0.02;
     switch (which % 6u) {
-    case 1: d = sph_world_def_default(3); d.spacing = (sph_real)0.025; break;
+    case 1:
+        d = sph_world_def_default(3);
+        d.spacing = (sph_real)0.025;
+        break;
     case 2: /* 1D gas: the energy array */
         d = sph_world_def_default(1);
         d.solver = SPH_SOLVER_COMPRESSIBLE;
@@ -51,8 +54,11 @@ static sph_status fzl_scene(sph_world* w, unsigned which, unsigned steps) {
         a.back_pressure = 1e5;
         walls = 0;
         break;
-    case 3: sph_world_def_pcisph(&d, 1); b.mass = (sph_real)0.3; break; /* two masses: w.m */
-    case 4: /* the second-order scheme: its lists are saved */
+    case 3:
+        sph_world_def_pcisph(&d, 1);
+        b.mass = (sph_real)0.3;
+        break; /* two masses: w.m */
+    case 4:    /* the second-order scheme: its lists are saved */
         d.scheme = SPH_SCHEME_SECOND_ORDER;
         d.kernel = SPH_KERNEL_QUINTIC;
         d.h_factor = (sph_real)1.2;
@@ -63,8 +69,12 @@ static sph_status fzl_scene(sph_world* w, unsigned which, unsigned steps) {
         a.sound_speed = 10;
         walls = 0;
         break;
-    case 5: d.solver = SPH_SOLVER_IISPH; d.boundary_volume = SPH_BVOL_AKINCI; break;
-    default: break;
+    case 5:
+        d.solver = SPH_SOLVER_IISPH;
+        d.boundary_volume = SPH_BVOL_AKINCI;
+        break;
+    default:
+        break;
     }
     d.max_iterations = 20;
     if ((s = sph_world_init(w, &d)) != SPH_OK) return s;
@@ -98,16 +108,21 @@ static void fzl_rebuild(const sph_world* l) {
     for (k = 0; k < l->nphase; ++k) {
         sph_phase ph = l->phases[k];
         if (ph.eos == SPH_EOS_IDEAL_GAS) ph.sound_speed = 0;
-        FZC_ASSERT(sph_world_add_phase(&r, &ph) == k, "the loader accepted phase %d, which "
-                   "sph_world_add_phase refuses: %s", k, r.error);
+        FZC_ASSERT(sph_world_add_phase(&r, &ph) == k,
+                   "the loader accepted phase %d, which "
+                   "sph_world_add_phase refuses: %s",
+                   k, r.error);
     }
     for (i = 0; i < l->n; ++i) {
         const sph_real m = l->m ? l->m[i] : l->mass;
-        s = sph_add_fluid_ex(&r, l->phase[i], 1, l->x + i * (size_t)l->dim, l->v + i * (size_t)l->dim,
-                             &m, &l->rho[i]);
-        FZC_ASSERT(s == SPH_OK, "the loader accepted fluid particle %zu, which sph_add_fluid_ex "
-                   "refuses: %s", i, r.error);
-        FZC_ASSERT(isfinite((double)l->p[i]), "the loader accepted p[%zu] = %g", i, (double)l->p[i]);
+        s = sph_add_fluid_ex(&r, l->phase[i], 1, l->x + i * (size_t)l->dim,
+                             l->v + i * (size_t)l->dim, &m, &l->rho[i]);
+        FZC_ASSERT(s == SPH_OK,
+                   "the loader accepted fluid particle %zu, which sph_add_fluid_ex "
+                   "refuses: %s",
+                   i, r.error);
+        FZC_ASSERT(isfinite((double)l->p[i]), "the loader accepted p[%zu] = %g", i,
+                   (double)l->p[i]);
         FZC_ASSERT(l->id[i] < l->next_id, "the loader accepted id %u >= next id %u",
                    (unsigned)l->id[i], (unsigned)l->next_id);
     }
@@ -124,7 +139,8 @@ static void fzl_rehash(unsigned char* b, size_t n) {
     uint64_t h = 14695981039346656037ull;
     size_t i;
     if (n < 8) return;
-    for (i = 0; i + 8 < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
+    for (i = 0; i + 8 < n; ++i)
+        h = (h ^ b[i]) * 1099511628211ull;
     memcpy(b + n - 8, &h, 8);
 }
 
@@ -139,7 +155,8 @@ static void fzl_edit(fzc_reader* r, unsigned char* b, size_t* size) {
     } else if (kind == 1) { /* a run of reals: "every wall volume" */
         const sph_real x = (sph_real)v;
         size_t k;
-        for (k = 0; k < 64 && (k + 1) * sizeof x <= room; ++k) memcpy(b + off + k * sizeof x, &x, sizeof x);
+        for (k = 0; k < 64 && (k + 1) * sizeof x <= room; ++k)
+            memcpy(b + off + k * sizeof x, &x, sizeof x);
     } else if (kind == 2 && room >= 8) {
         memcpy(b + off, &v, 8);
     } else if (kind == 3 && room >= 4) {
@@ -174,7 +191,8 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     FZC_ASSERT(bytes && sph_world_save_mem(&w, bytes, n) == n, "save_mem");
     sph_world_free(&w);
     edits = fzc_u8(&r) % 16u;
-    for (e = 0; e < edits; ++e) fzl_edit(&r, bytes, &n);
+    for (e = 0; e < edits; ++e)
+        fzl_edit(&r, bytes, &n);
     flags = fzc_u8(&r);
     if (!(flags & 1u)) fzl_rehash(bytes, n);
     s = sph_world_load_mem(&l, bytes, n, NULL);

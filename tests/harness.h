@@ -41,7 +41,7 @@ extern const th_test tests_reliability[];
 extern const th_test tests_reliability_long[];
 extern const th_test tests_oom[]; /* out of memory: every allocation failing once */
 extern const th_test tests_validation[]; /* methods failing are detected (issue 7) */
-extern const th_test tests_hostile[]; /* hostile input: loader, far coordinates, callbacks (issue 19) */
+extern const th_test tests_hostile[]; /* hostile input (issue 19) */
 
 void th_fail(const char* file, int line, const char* fmt, ...);
 void th_note(const char* fmt, ...);

@@ -69,12 +69,18 @@ static size_t ref_wall_box(const sph_world* w, const sph_real* lo, const sph_rea
     }
     pts = (sph_real*)malloc(total * (size_t)dim * sizeof(sph_real) + 1);
     vol = (sph_real*)malloc(total * sizeof(sph_real) + 1);
-    if (!pts || !vol) { nw = (size_t)-1; goto done; }
+    if (!pts || !vol) {
+        nw = (size_t)-1;
+        goto done;
+    }
     for (i = 0; i < total; ++i) {
         size_t r = i, ix[3] = {0, 0, 0};
         int outside = 0, open = 0;
         sph_real V = 1;
-        for (k = 0; k < dim; ++k) { ix[k] = r % cnt[k]; r /= cnt[k]; }
+        for (k = 0; k < dim; ++k) {
+            ix[k] = r % cnt[k];
+            r /= cnt[k];
+        }
         for (k = 0; k < dim; ++k) {
             int sd = side[k][ix[k]];
             if (sd != 0) outside = 1;
@@ -83,11 +89,16 @@ static size_t ref_wall_box(const sph_world* w, const sph_real* lo, const sph_rea
             V *= width[k][ix[k]];
         }
         if (!outside || open) continue;
-        for (k = 0; k < dim; ++k) pts[nw * (size_t)dim + (size_t)k] = coord[k][ix[k]];
+        for (k = 0; k < dim; ++k)
+            pts[nw * (size_t)dim + (size_t)k] = coord[k][ix[k]];
         vol[nw++] = V;
     }
 done:
-    for (k = 0; k < 3; ++k) { free(coord[k]); free(width[k]); free(side[k]); }
+    for (k = 0; k < 3; ++k) {
+        free(coord[k]);
+        free(width[k]);
+        free(side[k]);
+    }
     *pts_out = pts;
     *vol_out = vol;
     return nw;
@@ -99,8 +110,8 @@ done:
    spacing, and a second box added after the first. */
 static void test_wall_box_matches_lattice_walk(void) {
     static const double boxes[][6] = {
-        {0, 0, 0, 1.0, 0.5, 0.3},          {-0.13, 0.07, 0.2, 0.313, 0.52, 0.61},
-        {0, 0, 0, 0.05, 0.05, 0.05},       {1.0, -2.0, 3.0, 1.031, -1.71, 3.047},
+        {0, 0, 0, 1.0, 0.5, 0.3},    {-0.13, 0.07, 0.2, 0.313, 0.52, 0.61},
+        {0, 0, 0, 0.05, 0.05, 0.05}, {1.0, -2.0, 3.0, 1.031, -1.71, 3.047},
         {0, 0, 0, 0.4, 0.05, 0.25},
     };
     static const int layer_set[] = {0, 1, 2, 3, 5};
@@ -117,7 +128,10 @@ static void test_wall_box_matches_lattice_walk(void) {
                     size_t nref, nb0, b;
                     int k, pass;
                     d.spacing = (sph_real)0.05;
-                    if (sph_world_init(&w, &d) != SPH_OK) { CHECK(0); return; }
+                    if (sph_world_init(&w, &d) != SPH_OK) {
+                        CHECK(0);
+                        return;
+                    }
                     for (k = 0; k < 3; ++k) {
                         lo[k] = (sph_real)boxes[bx][k];
                         hi[k] = (sph_real)boxes[bx][3 + k];
@@ -128,9 +142,10 @@ static void test_wall_box_matches_lattice_walk(void) {
                         CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, layer_set[li], open), SPH_OK);
                         ++cases;
                         if (nref == (size_t)-1 || w.nb - nb0 != nref) {
-                            CHECK_MSG(0, "dim %d box %d layers %d open %u: %zu wall particles, "
-                                      "the lattice walk gives %zu", dim, bx, layer_set[li], open,
-                                      w.nb - nb0, nref);
+                            CHECK_MSG(0,
+                                      "dim %d box %d layers %d open %u: %zu wall particles, "
+                                      "the lattice walk gives %zu",
+                                      dim, bx, layer_set[li], open, w.nb - nb0, nref);
                             ++mismatches;
                         } else {
                             int same = memcmp(w.b_x + nb0 * (size_t)dim, pts,
@@ -139,8 +154,10 @@ static void test_wall_box_matches_lattice_walk(void) {
                             for (b = nb0; b < w.nb; ++b)
                                 if (w.b_id[b] != (uint32_t)b || w.b_body[b] != 0) same = 0;
                             if (!same) {
-                                CHECK_MSG(0, "dim %d box %d layers %d open %u: positions, "
-                                          "volumes or ids differ", dim, bx, layer_set[li], open);
+                                CHECK_MSG(0,
+                                          "dim %d box %d layers %d open %u: positions, "
+                                          "volumes or ids differ",
+                                          dim, bx, layer_set[li], open);
                                 ++mismatches;
                             }
                         }
@@ -198,9 +215,10 @@ static void test_wall_box_cost_follows_surface(void) {
     {
         sph_real lo3[3] = {0, 0, 0}, hi3[3] = {6, 6, 6};
         t0 = hs_now();
-        CHECK_EQ_INT(sph_add_wall_box(&w, lo3, hi3, 1,
-                                      SPH_FACE_XMAX | SPH_FACE_YMAX | SPH_FACE_ZMIN | SPH_FACE_ZMAX),
-                     SPH_OK);
+        CHECK_EQ_INT(
+            sph_add_wall_box(&w, lo3, hi3, 1,
+                             SPH_FACE_XMAX | SPH_FACE_YMAX | SPH_FACE_ZMIN | SPH_FACE_ZMAX),
+            SPH_OK);
         t = hs_now() - t0;
     }
     /* floor (y layer below, x from the closed layer through the box) and the xmin side */
@@ -233,7 +251,7 @@ static void test_wall_box_zero_volume(void) {
     sph_world_free(&w);
 }
 
-/* ---- loaded files are checked like the API's input -------------------------------------------- */
+/* ---- loaded files are checked like the API's input ----------------------------------------- */
 
 /* A small tank: 2D water 10 x 8 at dx = 0.02 in walls, 5 WCSPH steps taken. */
 static int hs_tank(sph_world* w, double x0) {
@@ -251,7 +269,8 @@ static int hs_tank(sph_world* w, double x0) {
     whi[0] = hi[0];
     whi[1] = (sph_real)0.24;
     if (sph_world_init(w, &d) != SPH_OK || sph_world_add_phase(w, &water) != 0 ||
-        sph_fill_box(w, 0, lo, hi) != SPH_OK || sph_add_wall_box(w, lo, whi, 0, SPH_FACE_YMAX) != SPH_OK ||
+        sph_fill_box(w, 0, lo, hi) != SPH_OK ||
+        sph_add_wall_box(w, lo, whi, 0, SPH_FACE_YMAX) != SPH_OK ||
         sph_set_hydrostatic(w) != SPH_OK)
         return 0;
     for (q = 0; q < 5; ++q)
@@ -264,7 +283,8 @@ static int hs_tank(sph_world* w, double x0) {
 static void hs_rehash(unsigned char* b, size_t n) {
     uint64_t h = 14695981039346656037ull;
     size_t i;
-    for (i = 0; i + 8 < n; ++i) h = (h ^ b[i]) * 1099511628211ull;
+    for (i = 0; i + 8 < n; ++i)
+        h = (h ^ b[i]) * 1099511628211ull;
     memcpy(b + n - 8, &h, 8);
 }
 
@@ -327,11 +347,21 @@ static void test_load_checks_fields(void) {
     int e, cases = 0;
     uint32_t zero = 0;
     static const char* const expect[] = {
-        "mass = -1",        "sph_phase.gamma = -3", "sph_phase.sound_speed = -5",
-        "sph_phase.viscosity = -1e+09", "vol of particle 0 = -1", "time = nan",
-        "id",               "pressure of particle 0", "x of particle 3 is not finite",
-        "density of particle 2", "v of particle 1", "phase 7 does not exist",
-        "too far from the origin", "b_x0 of particle", "stats field",
+        "mass = -1",
+        "sph_phase.gamma = -3",
+        "sph_phase.sound_speed = -5",
+        "sph_phase.viscosity = -1e+09",
+        "vol of particle 0 = -1",
+        "time = nan",
+        "id",
+        "pressure of particle 0",
+        "x of particle 3 is not finite",
+        "density of particle 2",
+        "v of particle 1",
+        "phase 7 does not exist",
+        "too far from the origin",
+        "b_x0 of particle",
+        "stats field",
         "sph_phase.mass = -2",
     };
     CHECK(hs_tank(&a, 0));
@@ -346,29 +376,61 @@ static void test_load_checks_fields(void) {
         sph_status s;
         memcpy(copy, bytes, n);
         switch (e) {
-        case 0: hs_put_real(copy, L.mass, -1); break;
-        case 1: hs_put_real(copy, L.phases + offsetof(sph_phase, gamma), -3); break;
-        case 2: hs_put_real(copy, L.phases + offsetof(sph_phase, sound_speed), -5); break;
-        case 3: hs_put_real(copy, L.phases + offsetof(sph_phase, viscosity), -1e9); break;
+        case 0:
+            hs_put_real(copy, L.mass, -1);
+            break;
+        case 1:
+            hs_put_real(copy, L.phases + offsetof(sph_phase, gamma), -3);
+            break;
+        case 2:
+            hs_put_real(copy, L.phases + offsetof(sph_phase, sound_speed), -5);
+            break;
+        case 3:
+            hs_put_real(copy, L.phases + offsetof(sph_phase, viscosity), -1e9);
+            break;
         case 4: /* every wall volume */
             xoff = hs_array(copy, L.boundary, 4, nbw);
-            for (i = 0; i < nbw; ++i) hs_put_real(copy, xoff + i * sizeof(sph_real), -1);
+            for (i = 0; i < nbw; ++i)
+                hs_put_real(copy, xoff + i * sizeof(sph_real), -1);
             break;
-        case 5: { double t = NAN; memcpy(copy + L.time, &t, 8); } break;
+        case 5: {
+            double t = NAN;
+            memcpy(copy + L.time, &t, 8);
+        } break;
         case 6: /* all ids equal, next id 0 */
             xoff = hs_array(copy, L.fluid, 4, nf);
-            for (i = 0; i < nf; ++i) memcpy(copy + xoff + 4 * i, &zero, 4);
+            for (i = 0; i < nf; ++i)
+                memcpy(copy + xoff + 4 * i, &zero, 4);
             memcpy(copy + L.next_id, &zero, 4);
             break;
-        case 7: hs_put_real(copy, hs_array(copy, L.fluid, 3, nf), NAN); break;
-        case 8: hs_put_real(copy, hs_array(copy, L.fluid, 0, nf) + 7 * sizeof(sph_real), NAN); break;
-        case 9: hs_put_real(copy, hs_array(copy, L.fluid, 2, nf) + 2 * sizeof(sph_real), -1); break;
-        case 10: hs_put_real(copy, hs_array(copy, L.fluid, 1, nf) + 3 * sizeof(sph_real), INFINITY); break;
-        case 11: copy[hs_array(copy, L.fluid, 5, nf) + 4] = 7; break;
-        case 12: hs_put_real(copy, hs_array(copy, L.fluid, 0, nf) + 4 * sizeof(sph_real), 1e30); break;
-        case 13: hs_put_real(copy, hs_array(copy, L.boundary, 3, nbw) + sizeof(sph_real), NAN); break;
-        case 14: { double v = -1; memcpy(copy + L.stats + offsetof(sph_stats, a_max), &v, 8); } break;
-        default: hs_put_real(copy, L.phases + offsetof(sph_phase, mass), -2); break;
+        case 7:
+            hs_put_real(copy, hs_array(copy, L.fluid, 3, nf), NAN);
+            break;
+        case 8:
+            hs_put_real(copy, hs_array(copy, L.fluid, 0, nf) + 7 * sizeof(sph_real), NAN);
+            break;
+        case 9:
+            hs_put_real(copy, hs_array(copy, L.fluid, 2, nf) + 2 * sizeof(sph_real), -1);
+            break;
+        case 10:
+            hs_put_real(copy, hs_array(copy, L.fluid, 1, nf) + 3 * sizeof(sph_real), INFINITY);
+            break;
+        case 11:
+            copy[hs_array(copy, L.fluid, 5, nf) + 4] = 7;
+            break;
+        case 12:
+            hs_put_real(copy, hs_array(copy, L.fluid, 0, nf) + 4 * sizeof(sph_real), 1e30);
+            break;
+        case 13:
+            hs_put_real(copy, hs_array(copy, L.boundary, 3, nbw) + sizeof(sph_real), NAN);
+            break;
+        case 14: {
+            double v = -1;
+            memcpy(copy + L.stats + offsetof(sph_stats, a_max), &v, 8);
+        } break;
+        default:
+            hs_put_real(copy, L.phases + offsetof(sph_phase, mass), -2);
+            break;
         }
         hs_rehash(copy, n);
         s = sph_world_load_mem(&b, copy, n, NULL);
@@ -485,7 +547,10 @@ static void test_far_coordinates_rejected(void) {
     CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_ERR_ARG);
     CHECK_MSG(strstr(w.error, "sph_fill_box") && strstr(w.error, "too far"), "%s", w.error);
     if (sizeof(sph_real) == 4) CHECK(strstr(w.error, "build in double") != NULL);
-    for (i = 0; i < 4; ++i) { x[2 * i] = (sph_real)(0.02 * (double)i); x[2 * i + 1] = 0; }
+    for (i = 0; i < 4; ++i) {
+        x[2 * i] = (sph_real)(0.02 * (double)i);
+        x[2 * i + 1] = 0;
+    }
     x[2 * 3 + 1] = (sph_real)-far;
     CHECK_EQ_INT(sph_add_fluid(&w, 0, 4, x, NULL), SPH_ERR_ARG);
     CHECK_EQ_INT(w.error_index, 3);
@@ -520,7 +585,8 @@ static void test_far_coordinates_rejected(void) {
             unsigned char* buf = (unsigned char*)malloc(n);
             sph_world_save_mem(&w, buf, n);
             CHECK_EQ_INT(sph_world_load_mem(&b, buf, n, NULL), SPH_ERR_ARG);
-            CHECK_MSG(strstr(b.error, "sph_world_load") && strstr(b.error, "too far"), "%s", b.error);
+            CHECK_MSG(strstr(b.error, "sph_world_load") && strstr(b.error, "too far"), "%s",
+                      b.error);
             sph_world_free(&b);
             free(buf);
         }
@@ -529,7 +595,6 @@ static void test_far_coordinates_rejected(void) {
     CHECK_EQ_INT(sph_step(&w, (sph_real)1e-4), SPH_OK);
     sph_world_free(&w);
 }
-
 
 /* ---- periodic grids with points far outside the box ---------------------------------------- */
 
@@ -563,7 +628,8 @@ static void test_periodic_grid_far_points(void) {
             size_t found = sph_grid_query(&g, x, &x[c], (sph_real)0.2, out, 4), q;
             int has0 = 0;
             sph_real d;
-            for (q = 0; q < found && q < 4; ++q) has0 |= out[q] == 0;
+            for (q = 0; q < found && q < 4; ++q)
+                has0 |= out[q] == 0;
             CHECK_MSG(has0, "the point at 0.55 + %g does not find its neighbour at 0.5",
                       c == 1 ? 2e12 : 3e11);
             sph_grid_delta(&g, &x[c], &x[0], &d);
@@ -612,13 +678,16 @@ static void test_periodic_grid_far_points(void) {
                 rr = sqrt(r2);
                 if (fabs(rr - (double)radius) < 1e-4) continue;
                 ++compared;
-                for (q = 0; q < found && q < n; ++q) in_query |= out[q] == (uint32_t)j;
-                for (q = 0; q < nl.count[i]; ++q) in_list |= nl.idx[nl.begin[i] + q] == (uint32_t)j;
+                for (q = 0; q < found && q < n; ++q)
+                    in_query |= out[q] == (uint32_t)j;
+                for (q = 0; q < nl.count[i]; ++q)
+                    in_list |= nl.idx[nl.begin[i] + q] == (uint32_t)j;
                 if (rr < (double)radius && (!in_query || (i != j && !in_list))) ++missing;
                 if (rr >= (double)radius && (in_query || in_list)) ++extra;
                 sph_grid_delta(&g, x + i * (size_t)dim, x + j * (size_t)dim, d);
                 r2 = 0;
-                for (k = 0; k < dim; ++k) r2 += (double)d[k] * (double)d[k];
+                for (k = 0; k < dim; ++k)
+                    r2 += (double)d[k] * (double)d[k];
                 if (fabs(sqrt(r2) - rr) > 1e-4) ++extra;
             }
         }
@@ -633,7 +702,6 @@ static void test_periodic_grid_far_points(void) {
     TH_NOTE("%d pairs against brute force: %d missing, %d wrong", compared, missing, extra);
 }
 
-
 /* ---- the force callback named when it writes a non-finite value ---------------------------- */
 
 typedef struct hs_bad_force {
@@ -641,14 +709,16 @@ typedef struct hs_bad_force {
     int count, armed;
 } hs_bad_force;
 
-static void hs_bad_force_fn(const sph_world* w, size_t begin, size_t end, sph_real* acc, void* user) {
+static void hs_bad_force_fn(const sph_world* w, size_t begin, size_t end, sph_real* acc,
+                            void* user) {
     const hs_bad_force* f = (const hs_bad_force*)user;
     size_t i;
     int q;
     for (i = begin; i < end; ++i) {
         acc[i * (size_t)w->dim] += (sph_real)0.1;
         for (q = 0; f->armed && q < f->count; ++q)
-            if (w->id[i] == f->ids[q]) acc[i * (size_t)w->dim + (size_t)(q % w->dim)] = (sph_real)NAN;
+            if (w->id[i] == f->ids[q])
+                acc[i * (size_t)w->dim + (size_t)(q % w->dim)] = (sph_real)NAN;
     }
 }
 
@@ -674,7 +744,8 @@ static sph_status hs_force_run(int solver, int verlet, const hs_bad_force* bad_i
     d.force_user = &bad;
     bad.armed = 0;
     if (sph_world_init(&w, &d) != SPH_OK || sph_world_add_phase(&w, &water) != 0 ||
-        sph_fill_box(&w, 0, lo, hi) != SPH_OK || sph_add_wall_box(&w, lo, whi, 0, SPH_FACE_YMAX) != SPH_OK ||
+        sph_fill_box(&w, 0, lo, hi) != SPH_OK ||
+        sph_add_wall_box(&w, lo, whi, 0, SPH_FACE_YMAX) != SPH_OK ||
         sph_set_hydrostatic(&w) != SPH_OK) {
         CHECK_MSG(0, "setup: %s", w.error);
         sph_world_free(&w);
@@ -692,9 +763,13 @@ static sph_status hs_force_run(int solver, int verlet, const hs_bad_force* bad_i
         size_t i, lowest = w.n;
         for (i = 0; i < w.n && lowest == w.n; ++i)
             for (q = 0; q < bad.count; ++q)
-                if (w.id[i] == bad.ids[q]) { lowest = i; break; }
-        CHECK_MSG((size_t)*index == lowest, "named particle %ld, the lowest poisoned index is %zu: %s",
-                  *index, lowest, w.error);
+                if (w.id[i] == bad.ids[q]) {
+                    lowest = i;
+                    break;
+                }
+        CHECK_MSG((size_t)*index == lowest,
+                  "named particle %ld, the lowest poisoned index is %zu: %s", *index, lowest,
+                  w.error);
     }
     sph_world_free(&w);
     return s;
@@ -705,8 +780,10 @@ static sph_status hs_force_run(int solver, int verlet, const hs_bad_force* bad_i
    2300, 7 and 1200 poisoned the lowest index among them is named, the same for 1 and 2 threads.
    Before, the error named the lowest index the NaN had spread to (id 1 in the issue). */
 static void test_force_callback_culprit(void) {
-    static const int solvers[][2] = {{SPH_SOLVER_WCSPH, 0}, {SPH_SOLVER_WCSPH, 1},
-                                     {SPH_SOLVER_PCISPH, 1}, {SPH_SOLVER_IISPH, 0},
+    static const int solvers[][2] = {{SPH_SOLVER_WCSPH, 0},
+                                     {SPH_SOLVER_WCSPH, 1},
+                                     {SPH_SOLVER_PCISPH, 1},
+                                     {SPH_SOLVER_IISPH, 0},
                                      {SPH_SOLVER_COMPRESSIBLE, 0}};
     hs_bad_force one, three;
     char msg[SPH_ERROR_SIZE];
@@ -780,7 +857,8 @@ static void test_motion_callback_culprit(void) {
     CHECK(sph_world_init(&w, &d) == SPH_OK && sph_world_add_phase(&w, &water) == 0 &&
           sph_fill_box(&w, 0, lo, hi) == SPH_OK &&
           sph_add_wall_box(&w, lo, whi, 0, SPH_FACE_YMAX) == SPH_OK);
-    for (q = 0; q < 3 && s == SPH_OK; ++q) s = sph_step(&w, (sph_real)1e-4);
+    for (q = 0; q < 3 && s == SPH_OK; ++q)
+        s = sph_step(&w, (sph_real)1e-4);
     CHECK_EQ_INT(s, SPH_ERR_ARG);
     CHECK_MSG(strstr(w.error, "(id 13)") && strstr(w.error, "boundary motion callback"), "%s",
               w.error);
