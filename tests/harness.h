@@ -44,6 +44,7 @@ extern const th_test tests_oom[]; /* out of memory: every allocation failing onc
 extern const th_test tests_validation[]; /* methods failing are detected (issue 7) */
 extern const th_test tests_scenes[]; /* user scenes through sph_advance with the defaults */
 extern const th_test tests_scenes_long[];
+extern const th_test tests_hostile[]; /* hostile input (issue 19) */
 
 void th_fail(const char* file, int line, const char* fmt, ...);
 void th_note(const char* fmt, ...);

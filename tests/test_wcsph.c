@@ -45,7 +45,9 @@ static double lattice_gradient_norm(const sph_kernel* k, double dx) {
 typedef struct hs_result {
     double err_mean, err_max, slope, norm;
     size_t outside;
+    int failed; /* sph_advance reported a failure (only allowed where hs_allow_fail is set) */
 } hs_result;
+static int hs_allow_fail;
 
 static hs_result run_hydrostatic(sph_world_def def, sph_eos eos, int res, double t_settle,
                                   double t_avg) {
@@ -75,7 +77,9 @@ static hs_result run_hydrostatic(sph_world_def def, sph_eos eos, int res, double
     cnt = (int*)calloc(w.n, sizeof(int));
     while (w.time < t_settle + t_avg - 1e-9) {
         if (sph_advance(&w, 0.05) != SPH_OK) {
-            th_fail(__FILE__, __LINE__, "advance: %s", w.error);
+            if (hs_allow_fail) TH_NOTE("reported: %s", w.error);
+            else th_fail(__FILE__, __LINE__, "advance: %s", w.error);
+            r.failed = 1;
             break;
         }
         if (w.stats.n_outside > r.outside) r.outside = w.stats.n_outside;
@@ -169,10 +173,12 @@ static void test_hydrostatic_boundary_schemes(void) {
     CHECK_EQ_INT(r.outside, 0);
     CHECK_LT(2 * ex.err_mean, r.err_mean);
     def.boundary_pressure = SPH_BP_ZERO;
+    hs_allow_fail = 1; /* particles get into the floor: counted, or the run reports it */
     r = run_hydrostatic(def, SPH_EOS_TAIT, 20, 1.5, 0.5);
-    TH_NOTE("WCSPH, zero-pressure walls: %zu particles counted below the floor (kept, reported)",
-            r.outside);
-    CHECK_LT(0, r.outside);
+    hs_allow_fail = 0;
+    TH_NOTE("WCSPH, zero-pressure walls: %zu particles counted below the floor%s",
+            r.outside, r.failed ? ", and the run reported its failure" : " (kept, reported)");
+    CHECK(0 < r.outside || r.failed);
 }
 
 /* Water columns in 1D (gravity along x) and 3D (a 0.2 m wide tank, not a whole number of
