@@ -1609,14 +1609,16 @@ SPHDEF void sph_kernel_grad(const sph_kernel* k, const sph_real* xij, sph_real* 
    first, as before, put the rounding of 1e13 cells into the cell index. */
 SPH__INLINE double sph__periodic_offset(const sph_grid* g, int k, sph_real xk) {
     double u;
-    if (xk >= g->lo[k] && xk < g->lo[k] + g->len[k]) return (double)(xk - g->lo[k]);
+    /* within a box length of the box: the old arithmetic (the cell index is wrapped later), so
+       rounding at the support radius is the brute force's */
+    if (xk >= g->lo[k] - g->len[k] && xk < g->lo[k] + 2 * g->len[k]) return (double)(xk - g->lo[k]);
     u = fmod((double)xk - (double)g->lo[k], (double)g->len[k]);
     return u < 0 ? u + (double)g->len[k] : u;
 }
 
 /* xk moved into the periodic box of direction k (itself when it lies in the box). */
 SPH__INLINE sph_real sph__periodic_wrap(const sph_grid* g, int k, sph_real xk) {
-    if (xk >= g->lo[k] && xk < g->lo[k] + g->len[k]) return xk;
+    if (xk >= g->lo[k] - g->len[k] && xk < g->lo[k] + 2 * g->len[k]) return xk; /* as above */
     return (sph_real)((double)g->lo[k] + sph__periodic_offset(g, k, xk));
 }
 

@@ -11,6 +11,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 enum { PADDLE = 1, BLOCK = 2 };             /* body tags of the boundary particles */
 static const double A = 0.04, PERIOD = 1.0; /* paddle stroke amplitude [m] and period [s] */
@@ -44,7 +45,7 @@ int main(int argc, char** argv) {
     const char* dir = argc > 1 ? argv[1] : "out/first_scene";
     const double dx = 0.02;
     sph_world_def def = sph_world_def_default(2);
-    sph_phase water = {0};
+    sph_phase water;
     sph_world w;
     sph_real lo[2] = {0, 0}, tank[2] = {2.0, 1.0}, block[2 * 150], paddle[2 * 3 * 30];
     sph_real a0[2] = {0.2, 0}, a1[2] = {1.1, 0.5}, b0[2] = {1.1, 0.2}, b1[2] = {1.4, 0.5};
@@ -55,6 +56,7 @@ int main(int argc, char** argv) {
     def.spacing = (sph_real)dx;
     def.force = beach;
     def.boundary_motion = move_paddle;
+    memset(&water, 0, sizeof water);
     water.rest_density = 1000;
     if (sph_world_init(&w, &def) != SPH_OK) { printf("%s\n", w.error); return 1; }
     /* water around the block: three boxes, each a whole number of spacings wide and high */

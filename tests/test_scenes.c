@@ -269,11 +269,11 @@ static void sc_defaults(sc_scene sc, int dim, double dx, double duration) {
     for (si = 0; si < (int)(sizeof sc_solvers / sizeof sc_solvers[0]); ++si) {
         const sc_solver* so = &sc_solvers[si];
         const sc_result r = sc_run(sc, so, -1, dim, dx, duration);
-        if (so->pcisph == 1) {
-            /* Enhanced PCISPH (Adami walls, Verlet, continuity density) is not there yet: its
-               dam break, sloshing tank and ring fail within 0.05 s and its enclosed 3D box gains
-               energy before it fails (printed above). Held to what every run must do: report
-               the failure (sc_run), keep the mass, and let nothing through a wall unreported. */
+        if (so->pcisph == 1 && sc == SC_BOX) {
+            /* Enhanced PCISPH (Adami walls, Verlet, continuity density) does not hold a box the
+               fluid fills: it fails at t = 0.35 s in 2D and 0.05 s in 3D (printed above).
+               Held to what every run must do: report the failure (sc_run), keep the mass, and
+               let nothing through a wall unreported. */
             CHECK(!r.silent_escape);
             CHECK_LE(r.mass_err, 1e-12);
             continue;
