@@ -126,7 +126,8 @@ int main(void) {
    passes per step over one neighbour list (forces, then the density rate with the new velocities,
    which stable integration of the acoustic waves requires). sph_stable_dt combines the acoustic CFL
    (0.25 h / (c0 + |v|)), the viscous limit (0.125 h^2 / nu) and the force limit
-   (0.25 sqrt(h / |a|)); sph_advance(&w, duration) steps with it, landing exactly on the end.
+   (0.25 sqrt(h / |a|)); sph_advance(&w, duration) steps with it, landing exactly on the end
+   (see ERRORS for what it does when a step fails).
 
    WCSPH, SECOND-ORDER SCHEME (def.scheme = SPH_SCHEME_SECOND_ORDER; periodic domains only)
    Negi & Ramachandran 2022, L-IPST-C: the fluid density rho (w->rho) is carried by
@@ -250,8 +251,15 @@ int main(void) {
    particle index and id, value) and w.error_index the particle. Bad input (an invalid def field
    or phase, non-finite positions or velocities, dt <= 0, a bad phase index) is rejected before
    anything changes. A blow-up (a non-finite value, density <= 0, compression beyond
-   def.max_compression, a speed beyond def.max_speed or the largest c0) is reported as
-   SPH_ERR_UNSTABLE at the step where it happens, naming the first offending particle. The
+   def.max_compression, a speed beyond def.max_speed's bound, a particle moving more than
+   def.max_displacement spacings in one step or ending inside a wall's layers, def.check_walls)
+   is reported as SPH_ERR_UNSTABLE at the step where it happens, naming the first offending
+   particle; an iterative pressure solve that stops at max_iterations above its tolerance returns
+   SPH_ERR_NOT_CONVERGED (the step was taken). sph_advance turns both into retries: the failed
+   sub-step is undone bit for bit and taken again at half the step (up to 12 times in a row, the
+   pressure solve starting cold), the step grows back by 1.1 per success, at most
+   def.max_substeps sub-steps a call (SPH_ERR_BUDGET); when it gives up, the world is as before
+   the call. Which scenes each solver holds this way is measured in tests/test_scenes.c. The
    library never calls exit or abort on user input and never drops particles: particles leaving
    def.domain are counted in w.stats.n_outside and kept. An allocation that fails makes the call
    return SPH_ERR_NOMEM ("out of memory" in w.error) with nothing added and no step taken (a step
