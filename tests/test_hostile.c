@@ -148,9 +148,12 @@ static void test_wall_box_matches_lattice_walk(void) {
                                       dim, bx, layer_set[li], open, w.nb - nb0, nref);
                             ++mismatches;
                         } else {
-                            int same = memcmp(w.b_x + nb0 * (size_t)dim, pts,
-                                              nref * (size_t)dim * sizeof(sph_real)) == 0 &&
-                                       memcmp(w.b_vol + nb0, vol, nref * sizeof(sph_real)) == 0;
+                            /* nref = 0 (every face open): no arrays to compare (memcmp of
+                               NULL is undefined even for 0 bytes) */
+                            int same = nref == 0 ||
+                                       (memcmp(w.b_x + nb0 * (size_t)dim, pts,
+                                               nref * (size_t)dim * sizeof(sph_real)) == 0 &&
+                                        memcmp(w.b_vol + nb0, vol, nref * sizeof(sph_real)) == 0);
                             for (b = nb0; b < w.nb; ++b)
                                 if (w.b_id[b] != (uint32_t)b || w.b_body[b] != 0) same = 0;
                             if (!same) {
