@@ -6674,7 +6674,11 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
             if (last) w->time = t_end;
             continue;
         }
-        if ((s == SPH_ERR_UNSTABLE || s == SPH_ERR_NOT_CONVERGED) && in_row < SPH__RETRIES) {
+        /* retry, unless 12 failed in a row or the step has come down to 1/4096 of the rule
+           (failures between successes: the scene needs a step the rule does not give, and a
+           run of ever smaller steps would only spend the sub-step budget) */
+        if ((s == SPH_ERR_UNSTABLE || s == SPH_ERR_NOT_CONVERGED) && in_row < SPH__RETRIES &&
+            0.5 * fmin(w->stats.dt_factor, dt / dt_stable) >= 1.0 / 4096) {
             sph__snapshot_restore(w, substeps > 1 ? 1 : 0);
             ++retries;
             ++in_row;
@@ -6695,9 +6699,9 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
             t = w->time;
             if (s == SPH_ERR_UNSTABLE || s == SPH_ERR_NOT_CONVERGED)
                 return sph__fail(w, s, idx,
-                                 "sph_advance: the sub-step failed %d times in a row, the last "
-                                 "at dt = %g s (%g of the stable step); the world is as before "
-                                 "the call (t = %g s). Last failure: %s",
+                                 "sph_advance: the sub-step failed (%d in a row), the last at dt "
+                                 "= %g s (%g of the stable step); the world is as before the "
+                                 "call (t = %g s). Last failure: %s",
                                  in_row + 1, dt, dt / dt_stable, t, msg);
             w->status = s; /* other errors keep their own message */
             memcpy(w->error, msg, sizeof msg);
