@@ -6144,7 +6144,7 @@ static void sph__dfsph_velocity(sph_world* w, const sph__ctx* c, const sph_real*
    does not depend on the thread count. */
 static double sph__dfsph_error(sph_world* w, const sph__ctx* c, sph_real dt, int density) {
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
-    const sph_real inv_s = 1 / w->priv.lattice_sum;
+    const sph_real inv_s = 1 / w->priv.lattice_sum, keep = density ? sph__standing_keep(w) : 0;
     double sum = 0;
     sph__idx blk;
     size_t q;
@@ -6158,7 +6158,8 @@ static double sph__dfsph_error(sph_world* w, const sph__ctx* c, sph_real dt, int
         for (i = i0; i < i1; ++i) {
             const sph__phase_c* P = &c->pc[c->ph[i]];
             sph_real r = w->drho[i] * inv_s;
-            if (density) r = w->rho[i] + dt * r - P->rho0;
+            if (density) /* a shortened step leaves part of the standing compression */
+                r = w->rho[i] + dt * r - P->rho0 - keep * (w->rho[i] > P->rho0 ? w->rho[i] - P->rho0 : 0);
             w->drho[i] = r; /* signed: expansion lowers the pressure (to 0 at most) */
             if (r > 0) e += (double)(density ? r * P->inv_rho0 : r * dt * P->inv_rho0);
         }
