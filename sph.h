@@ -4597,8 +4597,8 @@ static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, s
     return sph__integrate_with(w, c, w->a, kv, kr, kx, final);
 }
 
-/* The share of the compression standing at a step's start that PCISPH and IISPH leave for later
-   steps. Both solves drive the predicted density to rho0 within the step, so a standing
+/* The share of the compression standing at a step's start that PCISPH, IISPH and DFSPH leave
+   for later steps. Their density solves drive the predicted density to rho0 within the step, so a standing
    compression delta is removed by a velocity of about delta dx / dt: the smaller the step, the
    harder the kick. When sph_advance retries a failed step at half the size, that kick would
    double and the retry fail harder (with an ever smaller step it grows without bound). A step

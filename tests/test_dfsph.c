@@ -616,8 +616,7 @@ static void test_df_determinism(void) {
    when DFSPH's density solve corrected all of the standing compression in the retried steps,
    the water jumped: the total energy rose by 0.34 rho g H^2 W within 0.3 s (kinetic energy
    1718 J after the first 0.05 s, particles at 4 m/s; 0 rise and 1.7 J with the fix). Held to:
-   the total energy (kinetic plus
-   potential) does not rise by more than 0.5 % of rho g H^2 W in any frame, through sph_advance
+   the total energy (kinetic plus potential) does not rise by more than 0.5 % of rho g H^2 W in any frame, through sph_advance
    with the defaults. */
 static void test_df_retry(void) {
     sph_world_def def = sph_world_def_default(2);
