@@ -4598,8 +4598,8 @@ static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, s
 }
 
 /* The share of the compression standing at a step's start that PCISPH, IISPH and DFSPH leave
-   for later steps. Their density solves drive the predicted density to rho0 within the step, so a standing
-   compression delta is removed by a velocity of about delta dx / dt: the smaller the step, the
+   for later steps. Their density solves drive the predicted density to rho0 within the step,
+   so a standing compression delta is removed by a velocity of about delta dx / dt: the smaller the step, the
    harder the kick. When sph_advance retries a failed step at half the size, that kick would
    double and the retry fail harder (with an ever smaller step it grows without bound). A step
    shortened below the solver's rule dt_rule therefore corrects only dt / dt_rule of the
