@@ -318,6 +318,8 @@ static void test_box_2d(void) { sc_defaults(SC_BOX, 2, 0.04, 0.5); }
 static void test_ring_2d(void) { sc_defaults(SC_RING, 2, 0.04, 1.0); }
 static void test_tank_3d(void) { sc_defaults(SC_TANK, 3, 0.04, 0.5); }
 static void test_box_3d(void) { sc_defaults(SC_BOX, 3, 0.05, 0.3); }
+static void test_dam_3d(void) { sc_defaults(SC_DAM, 3, 0.025, 0.3); }
+static void test_slosh_3d(void) { sc_defaults(SC_SLOSH, 3, 0.04, 0.3); }
 
 static void test_tank_2d_long(void) { sc_defaults(SC_TANK, 2, 0.02, 3.0); }
 static void test_dam_2d_long(void) { sc_defaults(SC_DAM, 2, 0.02, 2.0); }
@@ -340,7 +342,8 @@ static void test_schemes_3d_long(void) {
 const th_test tests_scenes[] = {{"scenes/tank_2d", test_tank_2d},   {"scenes/dam_2d", test_dam_2d},
                                 {"scenes/slosh_2d", test_slosh_2d}, {"scenes/box_2d", test_box_2d},
                                 {"scenes/ring_2d", test_ring_2d},   {"scenes/tank_3d", test_tank_3d},
-                                {"scenes/box_3d", test_box_3d},     {0, 0}};
+                                {"scenes/box_3d", test_box_3d},     {"scenes/dam_3d", test_dam_3d},
+                                {"scenes/slosh_3d", test_slosh_3d}, {0, 0}};
 const th_test tests_scenes_long[] = {{"long/scenes/tank_2d", test_tank_2d_long},
                                      {"long/scenes/dam_2d", test_dam_2d_long},
                                      {"long/scenes/slosh_2d", test_slosh_2d_long},
