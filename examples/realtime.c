@@ -804,7 +804,7 @@ int main(int argc, char** argv) {
                "tolerance %g, OMP_WAIT_POLICY=%s\n", scene_scale, len(TANK_W), len(TANK_H),
                len(DEPTH), d.dx, d.tol_iisph, getenv("OMP_WAIT_POLICY") ? getenv("OMP_WAIT_POLICY") : "unset");
         if (shot && status == 0) printf("realtime: screenshot %s\n", shot);
-        printf("real-time factor %.2f at %zu particles, solver %s\n",
+        printf("real-time factor %.3g at %zu particles, solver %s\n",
                run_wall > 0 ? run_sim / run_wall : 0, d.w.n,
                fixed >= 0 ? solver_arg[fixed] : "wcsph+pcisph+iisph");
     }

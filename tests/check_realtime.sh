@@ -66,7 +66,7 @@ run() { # run NAME ARGS...: NAME.png is the screenshot
         medians="$medians $(printf '%s\n' "$log" | awk '$1 == "realtime:" && $7 == "median" { print $2, $8, "ms" }')"
     fi
     # the demo's last line: "real-time factor X at N particles, solver S"
-    if ! factor=$(printf '%s\n' "$log" | tail -n 1 | grep -E '^real-time factor [0-9.]+ at [0-9]+ particles, solver [a-z+]+$'); then
+    if ! factor=$(printf '%s\n' "$log" | tail -n 1 | grep -E '^real-time factor [0-9.e+-]+ at [0-9]+ particles, solver [a-z+]+$'); then
         echo "FAIL check_realtime: $name did not end with 'real-time factor X at N particles, solver S'"
         fail=1
         return
