@@ -1,18 +1,25 @@
 /* realtime.c - an interactive 2D SPH tank for game programmers (SDL2).
-   About 10k water particles in a closed 1.6 m x 1.0 m tank: stir them with the mouse, run a wave
-   paddle, switch between the three pressure solvers while it runs. Each frame simulates at most
-   a fixed budget of wall time, so the window stays responsive; on a slow machine the water moves
-   in slow motion and the top line says by how much (simulated seconds per real second).
+   10k water particles in a closed tank: stir them with the mouse, run a wave paddle, switch
+   between the three pressure solvers while it runs. By default the tank is at game scale,
+   20 m x 12.5 m with 5 m of water and 0.1 m particles (--scale 1: the 1.6 m x 1.0 m model tank
+   it is scaled from, see "scene"), stepped by IISPH at a 1 % mean compression tolerance with
+   sph.h's own step control. Each frame simulates the wall time of the last frame within a budget
+   of wall time, so the window stays responsive; the top line shows the real-time factor
+   (simulated seconds per wall second). When the water falls behind real time for 2 s, the demo
+   starts a fresh tank with fewer particles and says so (--adapt 0: keep the detail, run in
+   slow motion instead).
 
    Build: cc -O2 -std=c99 -fopenmp -I. examples/realtime.c $(sdl2-config --cflags --libs) -lm \
              -o build/realtime                       (or: make realtime; Debian: libsdl2-dev)
-   Run:   ./build/realtime [--particles 10000] [--solver wcsph|pcisph|iisph]
-                           [--budget 25 (ms of simulation per frame)]
+   Run:   ./build/realtime [--particles 10000] [--solver wcsph|pcisph|iisph] [--scale 12.5]
+                           [--tolerance 0.01 (IISPH's)] [--adapt 1] [--budget 40 (ms per frame)]
    Check: xvfb-run -a ./build/realtime --frames 150 --screenshot out/realtime.png [--solver iisph]
           runs scripted input (a stirring drag, a pull, the paddle) without a user, then writes
-          the last frame as a PNG and one summary line per solver; exit status 1 if a step
-          failed or a particle left the tank. Without --solver the run switches
-          WCSPH -> PCISPH -> IISPH at each third. SDL_VIDEODRIVER=offscreen or dummy also work.
+          the last frame as a PNG, one summary line per solver and the final line
+          "real-time factor X at N particles, solver S" (simulated time over wall time of all
+          frames, drawing included; N at the end); exit status 1 if a step failed or a particle
+          left the tank. Without --solver the run switches WCSPH -> PCISPH -> IISPH at each
+          third. SDL_VIDEODRIVER=offscreen or dummy also work.
 
    Keys:  left mouse   stir: drags the water near the cursor along with the cursor's motion
           right mouse  pull: draws the water near the cursor towards it
@@ -30,17 +37,26 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
-/* ---- scene (SI units) ---------------------------------------------------------------------- */
-#define TANK_W 1.6    /* tank interior [m] */
+/* ---- scene (SI units) ----------------------------------------------------------------------
+   The constants describe the model tank, 1.6 m x 1.0 m. --scale S (default SCALE) builds it S
+   times larger: every length times S and, by Froude similarity (gravity stays 9.81 m/s^2),
+   every time and speed times sqrt(S), accelerations unchanged, kinematic viscosity times
+   S^1.5. The flow is then the model's, sqrt(S) times slower, and so is every step sph.h
+   chooses: the step grows like sqrt(dx) under gravity while the particle count stays. */
+#define SCALE 12.5    /* default: a 20 m x 12.5 m tank, 5 m of water, 0.1 m particles at 10k */
+#define TANK_W 1.6    /* model tank interior [m] */
 #define TANK_H 1.0
 #define DEPTH 0.4     /* water depth at rest [m]; the particle count sets the spacing */
 #define SOUND_SPEED 20.0 /* c0 [m/s]. sph.h's automatic 10 sqrt(2 g H) would be 28 m/s here; 20
                             keeps density errors to a few % and makes WCSPH's step 1.4x longer */
 #define VISCOSITY 1e-5   /* kinematic viscosity [m^2/s]: ten times water, calms the surface */
-/* PCISPH's tolerance (mean compression). Steps are sph.h's own (sph_stable_dt; sph_advance
-   halves a step that fails). The enhanced preset's 0.01 % costs over 7x more iterations here;
-   0.1 % keeps the surface calm. IISPH runs with its defaults. */
+/* Tolerances of the iterative solvers (mean predicted compression). Steps are sph.h's own
+   (sph_stable_dt; sph_advance halves a step that fails). IISPH at 1 %: its default 0.1 % needs
+   4x the iterations (11 against 2-3 per step here) for a surface a game does not show; 2 %
+   blew up. PCISPH keeps 0.1 %: at 1 % it let a particle out of the tank. */
+#define TOL_IISPH 0.01
 #define TOL_PCISPH 0.001
 #define PADDLE_BODY 1    /* body tag of the paddle's boundary particles */
 #define PADDLE_X 1.25    /* paddle centre [m] (snapped to the particle lattice) */
@@ -54,8 +70,15 @@
 #define STIR_TAU 0.05    /* [s] stir: relaxation time of the water's velocity to the cursor's */
 #define STIR_VMAX 2.5    /* [m/s] cursor speed cap: keeps the flow well below c0 */
 #define PULL_ACC 30.0    /* [m/s^2] pull towards the cursor */
-#define MAX_FRAME 0.05   /* [s] most simulated time per frame (after a stall, do not catch up) */
+#define MAX_FRAME 0.05   /* [s] of wall time: most time simulated per frame (after a stall, do
+                            not catch up); longer frames mean slow motion */
 #define PI 3.14159265358979
+
+/* The scene scale S (--scale), set once in main before any world exists; the callbacks read it
+   on the worker threads. */
+static double scene_scale = SCALE;
+static double len(double model) { return model * scene_scale; }         /* lengths [m] */
+static double tim(double model) { return model * sqrt(scene_scale); }   /* times [s], speeds */
 
 /* ---- screen -------------------------------------------------------------------------------- */
 #define WIN_W 960
@@ -86,6 +109,12 @@ typedef struct paddle {
 typedef struct demo {
     int particles, solver;      /* requested particle count; 0, 1, 2 = WCSPH, PCISPH, IISPH */
     double budget;              /* simulation wall time per frame [s] */
+    double tol_iisph;           /* IISPH's def.tolerance [-] */
+    int adapt;                  /* nonzero: fewer particles when the water falls behind real time */
+    double win_sim, win_real;   /* adapt: simulated and wall time [s] since the last reset */
+    int reduced;                /* times the detail was reduced */
+    int win_h;                  /* window height [px] */
+    double step_cost;           /* wall time of a sub-step [s], the last measured */
     sph_world w;
     int have_world;
     double goal;                /* simulated time the frames have asked for so far [s] */
@@ -134,21 +163,22 @@ static double now(void) { /* wall clock [s] */
    [begin, end): it reads the world and the mouse and writes only acc of its own particles. */
 static void mouse_force(const sph_world* w, size_t begin, size_t end, sph_real* acc, void* user) {
     const mouse* m = (const mouse*)user;
+    const double radius = len(STIR_RADIUS), tau = tim(STIR_TAU);
     size_t i;
     if (!m->stir && !m->pull) return;
     for (i = begin; i < end; ++i) {
         const double rx = (double)w->x[2 * i] - m->x, ry = (double)w->x[2 * i + 1] - m->y;
         const double r = sqrt(rx * rx + ry * ry);
         double q, ax = 0, ay = 0;
-        if (r >= STIR_RADIUS) continue;
-        q = (1 - r / STIR_RADIUS) * (1 - r / STIR_RADIUS); /* falloff, 1 at the cursor */
+        if (r >= radius) continue;
+        q = (1 - r / radius) * (1 - r / radius); /* falloff, 1 at the cursor */
         if (m->stir) { /* relax the velocity to the cursor's: the water follows the drag */
-            ax += (m->vx - (double)w->v[2 * i]) / STIR_TAU;
-            ay += (m->vy - (double)w->v[2 * i + 1]) / STIR_TAU;
+            ax += (m->vx - (double)w->v[2 * i]) / tau;
+            ay += (m->vy - (double)w->v[2 * i + 1]) / tau;
         }
         if (m->pull && r > 1e-9) { /* towards the cursor, damped so the blob does not ring */
-            ax += -PULL_ACC * rx / r - 5.0 * (double)w->v[2 * i];
-            ay += -PULL_ACC * ry / r - 5.0 * (double)w->v[2 * i + 1];
+            ax += -PULL_ACC * rx / r - 5.0 / tim(1) * (double)w->v[2 * i];
+            ay += -PULL_ACC * ry / r - 5.0 / tim(1) * (double)w->v[2 * i + 1];
         }
         acc[2 * i] += (sph_real)(q * ax);
         acc[2 * i + 1] += (sph_real)(q * ay);
@@ -160,19 +190,19 @@ static void mouse_force(const sph_world* w, size_t begin, size_t end, sph_real* 
    tank walls (body 0) stay where they are. Called once per step on the main thread. */
 static void paddle_motion(sph_world* w, double t, void* user) {
     paddle* p = (paddle*)user;
-    const double omega = 2 * PI / PADDLE_PERIOD;
+    const double omega = 2 * PI / tim(PADDLE_PERIOD), amp = len(PADDLE_AMP), ramp = tim(PADDLE_RAMP);
     const double dt = p->t_last >= 0 && t > p->t_last ? t - p->t_last : 0;
     double ds = 0, off, vel, acc;
     size_t b;
-    if (p->on && p->speed < 1) ds = fmin(dt / PADDLE_RAMP, 1 - p->speed);
-    if (!p->on && p->speed > 0) ds = -fmin(dt / PADDLE_RAMP, p->speed);
+    if (p->on && p->speed < 1) ds = fmin(dt / ramp, 1 - p->speed);
+    if (!p->on && p->speed > 0) ds = -fmin(dt / ramp, p->speed);
     p->speed += ds;
     p->phase += omega * p->speed * dt;
     p->t_last = t;
-    off = PADDLE_AMP * sin(p->phase);
-    vel = PADDLE_AMP * omega * p->speed * cos(p->phase);
-    acc = -PADDLE_AMP * omega * omega * p->speed * p->speed * sin(p->phase) +
-          (dt > 0 ? PADDLE_AMP * omega * cos(p->phase) * ds / dt : 0);
+    off = amp * sin(p->phase);
+    vel = amp * omega * p->speed * cos(p->phase);
+    acc = -amp * omega * omega * p->speed * p->speed * sin(p->phase) +
+          (dt > 0 ? amp * omega * cos(p->phase) * ds / dt : 0);
     for (b = 0; b < w->nb; ++b) {
         if (w->b_body[b] != PADDLE_BODY) continue;
         w->b_x[2 * b] = w->b_x0[2 * b] + (sph_real)off;
@@ -186,12 +216,12 @@ static void paddle_motion(sph_world* w, double t, void* user) {
 
 /* ---- world --------------------------------------------------------------------------------- */
 
-/* The particle spacing [m] for about `particles` particles in a layer DEPTH deep: TANK_W is a
-   whole number *nx of spacings. */
+/* The particle spacing [m] for about `particles` particles in a layer DEPTH deep: the tank's
+   width is a whole number *nx of spacings. */
 static double spacing(int particles, int* nx) {
     const int n = (int)floor(TANK_W / sqrt(TANK_W * DEPTH / particles) + 0.5);
     if (nx) *nx = n;
-    return TANK_W / n;
+    return len(TANK_W) / n;
 }
 
 /* Builds the world for d->solver: tank walls, the paddle (4 layers, so no wall particle sees
@@ -204,10 +234,10 @@ static sph_status build_world(demo* d, const sph_real* x, const sph_real* v, siz
        rows 0 .. ny-1 around it; ny is chosen so that at least d->particles fit */
     int nx;
     const double dx = spacing(d->particles, &nx);
-    const int ip = (int)floor(PADDLE_X / dx + 0.5), j0 = (int)floor(PADDLE_Y0 / dx + 0.5);
+    const int ip = (int)floor(len(PADDLE_X) / dx + 0.5), j0 = (int)floor(len(PADDLE_Y0) / dx + 0.5);
     const int ny = (d->particles - 4 * j0 + nx - 5) / (nx - 4);
-    const int npy = (int)((PADDLE_Y1 - PADDLE_Y0) / dx);
-    sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)TANK_W, (sph_real)TANK_H};
+    const int npy = (int)(len(PADDLE_Y1 - PADDLE_Y0) / dx);
+    sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)len(TANK_W), (sph_real)len(TANK_H)};
     sph_real* pad = NULL;
     sph_status s;
     int phase, i, k;
@@ -218,12 +248,13 @@ static sph_status build_world(demo* d, const sph_real* x, const sph_real* v, siz
     if (solver_id[d->solver] == SPH_SOLVER_PCISPH) sph_world_def_pcisph(&def, 1); /* sets solver */
     else def.solver = solver_id[d->solver];
     if (def.solver == SPH_SOLVER_PCISPH) def.tolerance = (sph_real)TOL_PCISPH;
+    if (def.solver == SPH_SOLVER_IISPH) def.tolerance = (sph_real)d->tol_iisph;
 
     /* the particles that left the tank, w.stats.n_outside: those beyond the centres of the first
        wall layer (the water's outer particles sit half a spacing inside the walls' inner face) */
     def.domain_lo[0] = def.domain_lo[1] = (sph_real)(-0.5 * dx);
-    def.domain_hi[0] = (sph_real)(TANK_W + 0.5 * dx);
-    def.domain_hi[1] = (sph_real)(TANK_H + 0.5 * dx);
+    def.domain_hi[0] = (sph_real)(len(TANK_W) + 0.5 * dx);
+    def.domain_hi[1] = (sph_real)(len(TANK_H) + 0.5 * dx);
     def.force = mouse_force;
     def.force_user = &d->m;
     def.boundary_motion = paddle_motion;
@@ -235,8 +266,8 @@ static sph_status build_world(demo* d, const sph_real* x, const sph_real* v, siz
     if (s != SPH_OK) return s;
     memset(&water, 0, sizeof(water));
     water.rest_density = 1000;
-    water.viscosity = (sph_real)VISCOSITY;
-    water.sound_speed = (sph_real)SOUND_SPEED;
+    water.viscosity = (sph_real)(VISCOSITY * scene_scale * sqrt(scene_scale));
+    water.sound_speed = (sph_real)tim(SOUND_SPEED);
     phase = sph_world_add_phase(&d->w, &water);
     if (phase < 0) return SPH_ERR_ARG;
     if (x) {
@@ -248,7 +279,7 @@ static sph_status build_world(demo* d, const sph_real* x, const sph_real* v, siz
         a1[1] = (sph_real)(ny * dx);
         s = sph_fill_box(&d->w, phase, a0, a1);
         a0[0] = (sph_real)((ip + 2) * dx);
-        a1[0] = (sph_real)TANK_W;
+        a1[0] = (sph_real)len(TANK_W);
         if (s == SPH_OK) s = sph_fill_box(&d->w, phase, a0, a1);
         a0[0] = (sph_real)((ip - 2) * dx);
         a1[0] = (sph_real)((ip + 2) * dx);
@@ -289,9 +320,53 @@ static void say(demo* d, const char* prefix, const char* text) {
 static int reset(demo* d) {
     d->pad.speed = 0; /* the paddle starts from rest (ramping up if on) */
     d->pad.phase = 0;
+    d->win_sim = d->win_real = 0; /* adapt() measures the new tank afresh */
     if (build_world(d, NULL, NULL, 0) == SPH_OK) return 1;
     say(d, "cannot build the scene: ", d->w.error);
     return 0;
+}
+
+/* Pixels per metre and the border around the tank (the walls' depth, which grows with the
+   spacing, and 1 cm of the model) so that the tank fills the window below the text band. */
+static void set_view(demo* d) {
+    const double layers = sph_kernel_support(SPH_KERNEL_WENDLAND_C2) *
+                          sph_kernel_default_h_factor(SPH_KERNEL_WENDLAND_C2); /* wall depth / dx */
+    d->margin = len(0.01) + spacing(d->particles, NULL) * ceil(layers - 1e-9);
+    d->scale = WIN_W / (len(TANK_W) + 2 * d->margin);
+    if (d->win_h > 0) d->scale = fmin(d->scale, (d->win_h - HUD_H) / (len(TANK_H) + 2 * d->margin));
+}
+
+/* Graceful degradation: after each frame, the simulated and the wall time since the last
+   reset. Once ADAPT_WINDOW of wall time shows the water behind real time (factor below
+   ADAPT_BELOW), a fresh tank with fewer particles: a step costs about N and the stable step
+   grows like sqrt(dx), N^-1/4, so the cost of a simulated second goes like N^1.25 and the count
+   drops to N f^0.8 (with a 10 % margin, at least 10 % and at most half of it). Never back up:
+   no oscillation between two details. Returns 0 if the new tank cannot be built. */
+#define ADAPT_WINDOW 2.0  /* [s] of wall time measured before a decision */
+#define ADAPT_BELOW 0.9   /* reduce below this real-time factor */
+#define ADAPT_MIN 1000    /* fewest particles */
+static int adapt(demo* d, double sim, double real) {
+    double f;
+    int n;
+    char why[160];
+    if (!d->adapt) return 1;
+    d->win_sim += sim;
+    d->win_real += real;
+    if (d->win_real < ADAPT_WINDOW) return 1;
+    f = d->win_sim / d->win_real;
+    d->win_sim = d->win_real = 0;
+    if (f >= ADAPT_BELOW || d->particles <= ADAPT_MIN) return 1;
+    n = (int)(d->particles * fmin(0.9, fmax(0.5, 0.9 * pow(f, 0.8))));
+    if (n < ADAPT_MIN) n = ADAPT_MIN;
+    snprintf(why, sizeof(why), "real-time factor %.2f over %.0f s: fewer particles, %zu -> ", f,
+             ADAPT_WINDOW, d->w.n);
+    d->particles = n;
+    ++d->reduced;
+    set_view(d);
+    if (!reset(d)) return 0;
+    snprintf(why + strlen(why), sizeof(why) - strlen(why), "%zu (fresh tank)", d->w.n);
+    say(d, "", why);
+    return 1;
 }
 
 /* Keys 1/2/3: a new world with the other solver's def, from the current particles. Rebuilding
@@ -308,32 +383,40 @@ static int switch_solver(demo* d, int solver) {
     memcpy(xv + 2 * n, d->w.v, sizeof(sph_real) * 2 * n);
     s = build_world(d, xv, xv + 2 * n, n);
     free(xv);
+    d->win_sim = d->win_real = 0;
     if (s == SPH_OK) return 1;
     say(d, "solver switch failed, reset: ", d->w.error);
     return reset(d);
 }
 
-/* Steps of sph_stable_dt until the simulated time reaches d->goal, or the wall-time budget is
-   spent (then the water runs in slow motion). Never shortens a step to land on the goal: a
-   sliver step makes the incompressible solvers correct their whole density error at once. */
+/* Advances the world towards d->goal (the simulated time the frames asked for) with sph.h's
+   own step control, within the wall-time budget: while the whole remainder fits the budget
+   (at the cost of the last sub-step), one sph_advance lands on the goal (it splits a short
+   remainder into halves, never a sliver step); otherwise one stable step at a time until the
+   budget is spent, and the water falls behind (slow motion, which the factor on screen shows
+   and adapt() answers). A remainder under half a step waits for the next frame. */
 static sph_status simulate(demo* d, double want, int* steps) {
     const double t0 = now();
-    double last = 0; /* wall time of the last step [s] */
     *steps = 0;
     if (d->goal > d->w.time + MAX_FRAME) d->goal = d->w.time + MAX_FRAME; /* drop the backlog */
     d->goal += want;
     for (;;) {
-        const double t1 = now();
-        sph_real dt;
+        const double t1 = now(), remaining = d->goal - d->w.time;
+        double dt, chunk;
         sph_status s;
-        if (*steps > 0 && t1 - t0 + last > d->budget) break; /* at least one step per frame */
-        dt = sph_stable_dt(&d->w, d->w.def.solver);
+        dt = (double)sph_stable_dt(&d->w, d->w.def.solver);
         if (!(dt > 0)) return d->w.status != SPH_OK ? d->w.status : SPH_ERR_UNSTABLE;
-        if (d->w.time + 0.5 * (double)dt > d->goal) break;
-        s = sph_advance(&d->w, dt); /* retries a failed step at a smaller one, or reports */
+        dt *= d->w.stats.dt_factor > 0 ? d->w.stats.dt_factor : 1; /* what sph_advance takes */
+        if (remaining < 0.5 * dt) break;
+        if (*steps > 0 && t1 - t0 + d->step_cost > d->budget) break; /* at least one step a frame */
+        /* one step is a hair under dt: sph_advance(w, dt) itself could see the remainder
+           (time + dt) - time round to just above dt and split it into two half steps */
+        chunk = d->step_cost > 0 && t1 - t0 + d->step_cost * ceil(remaining / dt) <= d->budget
+                    ? remaining : fmin(remaining, dt * (1 - 1e-9));
+        s = sph_advance(&d->w, (sph_real)chunk); /* retries a failed step at a smaller one */
         if (s != SPH_OK) return s;
-        ++*steps;
-        last = now() - t1;
+        *steps += d->w.stats.substeps;
+        d->step_cost = (now() - t1) / (d->w.stats.substeps > 0 ? d->w.stats.substeps : 1);
     }
     return SPH_OK;
 }
@@ -341,12 +424,12 @@ static sph_status simulate(demo* d, double want, int* steps) {
 /* ---- input --------------------------------------------------------------------------------- */
 
 /* Cursor velocity from its motion over the last frame's simulated time, so the water follows
-   the cursor as seen on screen even in slow motion; capped at STIR_VMAX. */
+   the cursor as seen on screen even in slow motion; capped at STIR_VMAX (scaled). */
 static void mouse_update(mouse* m, double sim_dt) {
     double vx = 0, vy = 0, sp;
     if (sim_dt > 1e-6) { vx = (m->x - m->px) / sim_dt; vy = (m->y - m->py) / sim_dt; }
     sp = sqrt(vx * vx + vy * vy);
-    if (sp > STIR_VMAX) { vx *= STIR_VMAX / sp; vy *= STIR_VMAX / sp; }
+    if (sp > tim(STIR_VMAX)) { vx *= tim(STIR_VMAX) / sp; vy *= tim(STIR_VMAX) / sp; }
     m->vx = 0.5 * (m->vx + vx); /* a little smoothing against jittery mouse events */
     m->vy = 0.5 * (m->vy + vy);
     m->px = m->x;
@@ -365,11 +448,11 @@ static void script_input(demo* d, int f, int nframes, int segments) {
     if (u >= 0.1 && u < 0.6) s = (u - 0.1) / 0.25 < 1 ? (u - 0.1) / 0.25 : 2 - (u - 0.1) / 0.25;
     if (u >= 0.85) s = (u - 0.85) / 0.15;
     if (s >= 0) {
-        d->m.x = 0.15 + 1.3 * s;
-        d->m.y = 0.22 + 0.08 * sin(4 * PI * s);
+        d->m.x = len(0.15 + 1.3 * s);
+        d->m.y = len(0.22 + 0.08 * sin(4 * PI * s));
     } else if (d->m.pull) {
-        d->m.x = 0.6;
-        d->m.y = 0.55;
+        d->m.x = len(0.6);
+        d->m.y = len(0.55);
     }
 }
 
@@ -377,7 +460,7 @@ static void script_input(demo* d, int f, int nframes, int segments) {
 
 static void world_to_px(const demo* d, double x, double y, int* px, int* py) {
     *px = (int)floor((x + d->margin) * d->scale);
-    *py = HUD_H + (int)floor((TANK_H + d->margin - y) * d->scale);
+    *py = HUD_H + (int)floor((len(TANK_H) + d->margin - y) * d->scale);
 }
 
 /* The square of a particle at x [m], size [px]. */
@@ -409,7 +492,7 @@ static void draw_particles(SDL_Renderer* r, demo* d) {
     memset(count, 0, sizeof(count));
     for (i = 0; i < w->n; ++i) { /* counting sort by colour */
         const double vx = (double)w->v[2 * i], vy = (double)w->v[2 * i + 1];
-        const double t = sqrt(vx * vx + vy * vy) / VCOLOR * (NBIN - 1) + 0.5;
+        const double t = sqrt(vx * vx + vy * vy) / tim(VCOLOR) * (NBIN - 1) + 0.5;
         d->bin[i] = (unsigned char)(t < NBIN - 1 ? t : NBIN - 1);
         ++count[d->bin[i]];
     }
@@ -428,8 +511,8 @@ static void draw_cursor(SDL_Renderer* r, const demo* d) {
     int k;
     if (!d->m.stir && !d->m.pull) return;
     for (k = 0; k <= 32; ++k)
-        world_to_px(d, d->m.x + STIR_RADIUS * cos(k * PI / 16),
-                    d->m.y + STIR_RADIUS * sin(k * PI / 16), &pt[k].x, &pt[k].y);
+        world_to_px(d, d->m.x + len(STIR_RADIUS) * cos(k * PI / 16),
+                    d->m.y + len(STIR_RADIUS) * sin(k * PI / 16), &pt[k].x, &pt[k].y);
     if (d->m.stir) SDL_SetRenderDrawColor(r, 220, 60, 40, 255);
     else SDL_SetRenderDrawColor(r, 40, 120, 220, 255);
     SDL_RenderDrawLines(r, pt, 33);
@@ -441,11 +524,12 @@ static void draw_hud(SDL_Renderer* r, SDL_Texture* tex, img* hud, const demo* d,
     char line[320];
     SDL_Rect band;
     img_fill(hud, 232, 232, 228);
-    snprintf(line, sizeof(line), "%s   %zu particles   %.2g sim s per real s",
-             solver_name[d->solver], d->w.n, m->ratio);
+    snprintf(line, sizeof(line), "%s   %zu particles of %.3g m   real-time factor %.2f%s",
+             solver_name[d->solver], d->w.n, d->dx, m->ratio, m->ratio < 0.95 ? " (slow motion)" : "");
     img_text(hud, 8, 4, 2, line, 20, 20, 30);
-    snprintf(line, sizeof(line), "sim %5.1f ms   frame %5.1f ms   %4.1f steps of %.2f ms",
-             m->sim_ms, m->frame_ms, m->steps, 1e3 * d->w.stats.dt);
+    snprintf(line, sizeof(line), "sim %5.1f ms   frame %5.1f ms   %4.1f steps of %.2f ms   "
+             "compression %.2f %%", m->sim_ms, m->frame_ms, m->steps, 1e3 * d->w.stats.dt,
+             100 * d->w.stats.compression_avg);
     img_text(hud, 8, 26, 2, line, 20, 20, 30);
     snprintf(line, sizeof(line), "keys: 1 WCSPH  2 PCISPH  3 IISPH   P paddle (%s)   R reset   "
              "Esc quit      mouse: left stir, right pull", d->pad.on ? "on" : "off");
@@ -466,7 +550,11 @@ typedef struct tally {
     int frames;
     long steps;
     double simulated; /* [s] */
+    double wall, cpu; /* wall time of its frames, drawing included, and the process's CPU time in
+                         them (all threads) [s]: cpu / wall near the thread count = a free machine */
+    double comp_max;  /* largest mean compression after a frame [-] */
     size_t outside;   /* most particles outside the tank after any frame */
+    size_t n;         /* particles at its last frame */
     int errors;       /* failed steps (each followed by a reset) */
 } tally;
 
@@ -512,18 +600,20 @@ int main(int argc, char** argv) {
     meter hudm; /* the numbers on screen */
     tally tal[3];
     img hud;
-    int frames = 0, fixed = -1, running = 1, frame = 0, steps = 0, status = 0, win_h, a, k;
+    int frames = 0, fixed = -1, running = 1, frame = 0, steps = 0, status = 0, a, k;
     const char* shot = NULL;
     SDL_Window* win = NULL;
     SDL_Renderer* ren;
     SDL_Texture* tex = NULL;
-    double t_prev, sim_dt = 0;
+    double t_prev, sim_dt = 0, run_sim = 0, run_wall = 0;
 
     memset(&d, 0, sizeof(d));
     memset(&hudm, 0, sizeof(hudm));
     memset(tal, 0, sizeof(tal));
     d.particles = 10000;
-    d.budget = 0.025;
+    d.budget = 0.040;
+    d.tol_iisph = TOL_IISPH;
+    d.adapt = 1;
     d.pad.on = 1;
     for (a = 1; a < argc; a += 2) { /* options come in pairs: --name value */
         const char* v = a + 1 < argc ? argv[a + 1] : NULL;
@@ -531,17 +621,24 @@ int main(int argc, char** argv) {
         else if (strcmp(argv[a], "--frames") == 0 && v) frames = atoi(v);
         else if (strcmp(argv[a], "--screenshot") == 0 && v) shot = v;
         else if (strcmp(argv[a], "--budget") == 0 && v) d.budget = atof(v) / 1000;
+        else if (strcmp(argv[a], "--scale") == 0 && v) scene_scale = atof(v);
+        else if (strcmp(argv[a], "--tolerance") == 0 && v) d.tol_iisph = atof(v);
+        else if (strcmp(argv[a], "--adapt") == 0 && v) d.adapt = atoi(v);
         else if (strcmp(argv[a], "--solver") == 0 && v && parse_solver(v) >= 0)
             fixed = parse_solver(v);
         else break;
     }
-    if (a < argc || d.particles < 100 || d.particles > 1000000 || frames < 0 || !(d.budget > 0)) {
+    if (a < argc || d.particles < 100 || d.particles > 1000000 || frames < 0 || !(d.budget > 0) ||
+        !(scene_scale >= 0.01 && scene_scale <= 1000) || !(d.tol_iisph > 0 && d.tol_iisph < 1)) {
         fprintf(stderr, "usage: %s [--particles 100..1000000] [--solver wcsph|pcisph|iisph] "
-                        "[--budget ms > 0] [--frames N [--screenshot out.png]]\n", argv[0]);
+                        "[--scale 0.01..1000 (%g)] [--tolerance IISPH's, 0..1 (%g)] [--adapt 0|1] "
+                        "[--budget ms > 0] [--frames N [--screenshot out.png]]\n", argv[0],
+                SCALE, TOL_IISPH);
         return 2;
     }
-    /* IISPH by default: in this tank it simulates a second 2.7x faster than WCSPH, 1.9x faster
-       than PCISPH; the check without --solver goes through all three in key order */
+    /* IISPH by default: in the 20 m tank at 10k particles a simulated second costs it 4.8 CPU
+       seconds, PCISPH 14 and WCSPH 20 (README, "Real time in a game"); the check without
+       --solver goes through all three in key order */
     d.solver = fixed >= 0 ? fixed : frames > 0 ? 0 : 2;
     for (k = 0; k < 3 && frames > 0; ++k) {
         tal[k].ms_frame = (double*)malloc(sizeof(double) * (size_t)frames);
@@ -551,11 +648,8 @@ int main(int argc, char** argv) {
 
     /* the window: the tank and its walls (support radius / dx layers, rounded up) fill the width
        below the text band */
-    d.margin = sph_kernel_support(SPH_KERNEL_WENDLAND_C2) *
-               sph_kernel_default_h_factor(SPH_KERNEL_WENDLAND_C2); /* support radius / dx */
-    d.margin = 0.01 + spacing(d.particles, NULL) * ceil(d.margin - 1e-9);
-    d.scale = WIN_W / (TANK_W + 2 * d.margin);
-    win_h = HUD_H + (int)ceil((TANK_H + 2 * d.margin) * d.scale);
+    set_view(&d);
+    d.win_h = HUD_H + (int)ceil((len(TANK_H) + 2 * d.margin) * d.scale);
 #if defined(__unix__) && !defined(__APPLE__)
     /* an interactive run needs a display: without one SDL may open an invisible window (or a
        console video driver) and the demo would run unseen until killed */
@@ -567,7 +661,7 @@ int main(int argc, char** argv) {
         return 1;
     }
 #endif
-    ren = open_window(WIN_W, win_h, frames > 0, &win);
+    ren = open_window(WIN_W, d.win_h, frames > 0, &win);
     if (ren && frames == 0 && SDL_GetCurrentVideoDriver() &&
         (strcmp(SDL_GetCurrentVideoDriver(), "offscreen") == 0 ||
          strcmp(SDL_GetCurrentVideoDriver(), "dummy") == 0)) {
@@ -593,6 +687,7 @@ int main(int argc, char** argv) {
     t_prev = now();
     while (running) {
         const double t0 = now(), real_dt = t0 - t_prev;
+        const clock_t c0 = clock();
         double t_sim0, sim_ms, frame_ms;
         sph_status s;
         SDL_Event ev;
@@ -621,8 +716,8 @@ int main(int argc, char** argv) {
             const Uint32 buttons = SDL_GetMouseState(&mx, &my);
             d.m.stir = (buttons & SDL_BUTTON(SDL_BUTTON_LEFT)) != 0;
             d.m.pull = (buttons & SDL_BUTTON(SDL_BUTTON_RIGHT)) != 0;
-            d.m.x = fmin(fmax(mx / d.scale - d.margin, 0.0), TANK_W); /* clamped into the tank */
-            d.m.y = fmin(fmax(TANK_H + d.margin - (my - HUD_H) / d.scale, 0.0), TANK_H);
+            d.m.x = fmin(fmax(mx / d.scale - d.margin, 0.0), len(TANK_W)); /* clamped into the tank */
+            d.m.y = fmin(fmax(len(TANK_H) + d.margin - (my - HUD_H) / d.scale, 0.0), len(TANK_H));
         }
         mouse_update(&d.m, sim_dt);
 
@@ -638,6 +733,8 @@ int main(int argc, char** argv) {
             t->steps += steps;
             t->simulated += s == SPH_OK ? sim_dt : 0;
             t->errors += s != SPH_OK;
+            if (s == SPH_OK && d.w.stats.compression_avg > t->comp_max)
+                t->comp_max = d.w.stats.compression_avg;
         }
         if (s != SPH_OK) { /* a demo must not crash: show why, start again */
             char why[64];
@@ -656,7 +753,7 @@ int main(int argc, char** argv) {
         draw_hud(ren, tex, &hud, &d, &hudm);
         if (shot && frame == frames - 1) {
             img pic;
-            if (!img_init(&pic, WIN_W, win_h) ||
+            if (!img_init(&pic, WIN_W, d.win_h) ||
                 SDL_RenderReadPixels(ren, NULL, SDL_PIXELFORMAT_RGB24, pic.rgb, 3 * WIN_W) != 0 ||
                 img_write_png(&pic, shot) != 0) {
                 fprintf(stderr, "realtime: screenshot %s failed (%s)\n", shot, SDL_GetError());
@@ -671,6 +768,17 @@ int main(int argc, char** argv) {
             tally* t = &tal[d.solver];
             t->ms_frame[t->frames] = frame_ms;
             t->ms_sim[t->frames++] = sim_ms;
+            t->n = d.w.n;
+        }
+        /* fewer particles if the water falls behind (a fresh tank, counted in this frame) */
+        if (!adapt(&d, sim_dt, real_dt)) { status = 1; break; }
+        if (frames > 0) {
+            tally* t = &tal[d.solver];
+            const double wall = now() - t0;
+            t->wall += wall;
+            t->cpu += (double)(clock() - c0) / CLOCKS_PER_SEC;
+            run_wall += wall;
+            run_sim += s == SPH_OK ? sim_dt : 0;
             if (++frame >= frames) running = 0;
         } else if (frame_ms < 4) {
             SDL_Delay(1); /* idle a little when the frame was cheap */
@@ -682,13 +790,25 @@ int main(int argc, char** argv) {
         const tally* t = &tal[k];
         if (t->frames == 0) continue;
         printf("realtime: %-6s particles %zu  frames %d  median %.1f ms/frame (sim %.1f ms)  "
-               "steps %ld (%.1f/frame)  simulated %.3f s  outside %zu  errors %d\n",
-               solver_arg[k], d.w.n, t->frames, median(t->ms_frame, t->frames),
+               "steps %ld (%.1f/frame)  simulated %.3f s in %.3f s (cpu %.2f s)  factor %.3f  "
+               "compression <= %.2f %%  outside %zu  errors %d\n",
+               solver_arg[k], t->n, t->frames, median(t->ms_frame, t->frames),
                median(t->ms_sim, t->frames), t->steps, (double)t->steps / t->frames, t->simulated,
+               t->wall, t->cpu, t->wall > 0 ? t->simulated / t->wall : 0, 100 * t->comp_max,
                t->outside, t->errors);
         if (t->outside > 0 || t->errors > 0) status = 1;
     }
-    if (shot && frames > 0 && status == 0) printf("realtime: screenshot %s\n", shot);
+    if (frames > 0) {
+        if (d.reduced) printf("realtime: detail reduced %d time(s) to keep up with real time\n",
+                              d.reduced);
+        printf("realtime: scale %g (tank %g m x %g m, water %g m deep, spacing %.3g m), IISPH "
+               "tolerance %g, OMP_WAIT_POLICY=%s\n", scene_scale, len(TANK_W), len(TANK_H),
+               len(DEPTH), d.dx, d.tol_iisph, getenv("OMP_WAIT_POLICY") ? getenv("OMP_WAIT_POLICY") : "unset");
+        if (shot && status == 0) printf("realtime: screenshot %s\n", shot);
+        printf("real-time factor %.3g at %zu particles, solver %s\n",
+               run_wall > 0 ? run_sim / run_wall : 0, d.w.n,
+               fixed >= 0 ? solver_arg[fixed] : "wcsph+pcisph+iisph");
+    }
     for (k = 0; k < 3; ++k) {
         free(tal[k].ms_frame);
         free(tal[k].ms_sim);

@@ -3,7 +3,9 @@
 # under a virtual X server, once per solver (10k particles) and once switching solvers at run
 # time (fewer particles). Each run plays scripted input (a stirring drag, a pull, the paddle),
 # writes its last frame to out/realtime_<solver>.png and prints a summary line with the median
-# ms/frame; the run fails if a step failed or a particle left the tank.
+# ms/frame and its last line "real-time factor X at N particles, solver S" (the demo lowers N
+# when it falls behind real time); the run fails if a step failed, a particle left the tank or
+# the last line is missing. The factors are printed, not asserted (they depend on the load).
 #
 #   tests/check_realtime.sh            under a minute on 2 cores, 15 s of it the build
 #   FRAMES=300 tests/check_realtime.sh more frames per solver (default 100)
@@ -46,6 +48,7 @@ fi
 # One run: xvfb-run with a software-rendered X11 window; the log keeps the summary lines.
 fail=0
 medians=""
+factors=""
 run() { # run NAME ARGS...: NAME.png is the screenshot
     local name=$1 png="out/realtime_$1.png" log
     shift
@@ -62,6 +65,14 @@ run() { # run NAME ARGS...: NAME.png is the screenshot
     if [ "$name" != switch ]; then # "realtime: iisph  particles 10036  frames 100  median 41.3 ms/frame ..."
         medians="$medians $(printf '%s\n' "$log" | awk '$1 == "realtime:" && $7 == "median" { print $2, $8, "ms" }')"
     fi
+    # the demo's last line: "real-time factor X at N particles, solver S"
+    if ! factor=$(printf '%s\n' "$log" | tail -n 1 | grep -E '^real-time factor [0-9.e+-]+ at [0-9]+ particles, solver [a-z+]+$'); then
+        echo "FAIL check_realtime: $name did not end with 'real-time factor X at N particles, solver S'"
+        fail=1
+        return
+    fi
+    factors="$factors
+  $name: $factor"
     if [ ! -s "$png" ]; then
         echo "FAIL check_realtime: $name wrote no screenshot $png"
         fail=1
@@ -79,5 +90,8 @@ if [ $fail -ne 0 ]; then
     echo "check_realtime: FAILED ($((SECONDS - start)) s)"
     exit 1
 fi
-echo "check_realtime: median ms/frame at 10k particles:$medians (OMP_WAIT_POLICY=$OMP_WAIT_POLICY)"
+# The factors are printed, not asserted: on a loaded 2-core CI machine they vary several times
+# over (the demo then lowers the particle count, which the lines show).
+echo "check_realtime: median ms/frame:$medians (OMP_WAIT_POLICY=$OMP_WAIT_POLICY)"
+echo "check_realtime: real-time factors (simulated s per wall s, drawing included; load $(cut -d' ' -f1 /proc/loadavg 2>/dev/null || echo unknown)):$factors"
 echo "check_realtime: passed in $((SECONDS - start)) s; screenshots out/realtime_*.png"
