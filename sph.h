@@ -6001,6 +6001,15 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
     s = sph__integrate(w, &c, 0, 0, dt, 1);
     sph__time(w, SPH_STAGE_INTEGRATE, &t0);
     w->stats.step_time = sph__now() - tstart;
+    /* the density check of sph__integrate reads rho at the step's start; a step whose solve
+       ends with a particle predicted beyond max_compression fails now, not one step late (where
+       no smaller step can undo it) */
+    if (s == SPH_OK && w->def.max_compression > 0 && errmax > (double)w->def.max_compression)
+        return sph__fail(w, SPH_ERR_UNSTABLE, -1,
+                         "step %llu (t = %g s): IISPH's solve ends with a particle predicted at "
+                         "rho/rho0 = %g (max_compression %g) after %d iterations: time step too "
+                         "large", (unsigned long long)w->steps, w->time, 1 + errmax,
+                         (double)w->def.max_compression, it);
     if (s == SPH_OK && (err > (double)w->def.tolerance ||
                         (w->def.tolerance_max > 0 && errmax > (double)w->def.tolerance_max)))
         s = sph__not_converged(w, "IISPH", it, err, errmax);
@@ -6652,7 +6661,9 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
             return sph__fail(w, s, -1, "sph_advance: no stable step at t = %g s: %s", w->time, msg);
         }
         dt = dt_stable * w->stats.dt_factor;
-        if (remaining <= dt) { dt = remaining; last = 1; }
+        /* a remainder within rounding of one step is that step (sph_advance(w, sph_stable_dt(w))
+           came out an ulp above the step and was split into two halves) */
+        if (remaining <= dt * (1 + 1e-5)) { dt = remaining; last = 1; }
         else if (remaining < 2 * dt) dt = 0.5 * remaining; /* no sliver of a last step */
         if (dt < 1e-12 * (double)duration && !last) {
             double t = w->time;
