@@ -1,0 +1,173 @@
+/* tests/test_viscous.c - viscous accuracy through sph_advance with the defaults (issue 18):
+   - plane Poiseuille flow between no-slip walls, periodic in x, driven by a body force g: the
+     steady profile u(y) = g y (H - y) / (2 nu) (Morris, Fox & Zhu 1997 sec. 4.1), centre speed
+     and RMS over the profile at 20 particles across (and 40 in the long set: the error must not
+     grow with resolution), WCSPH, IISPH and DFSPH;
+   - the periodic Taylor-Green vortex: its kinetic energy decays as exp(-16 pi^2 nu t / L^2)
+     (u = -U e^{bt} cos(2 pi x/L) sin(2 pi y/L), v = U e^{bt} sin(2 pi x/L) cos(2 pi y/L) solves
+     the Navier-Stokes equations with b = -8 pi^2 nu / L^2: the nonlinear term is a gradient,
+     balanced by the pressure, and nu Lap u = -8 pi^2 nu / L^2 u; the kinetic energy goes with
+     e^{2bt}); the measured decay rate per solver against that. */
+#include "harness.h"
+#include "../sph.h"
+#include "../examples/scenes.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+/* ---- plane Poiseuille flow ------------------------------------------------------------------ */
+
+typedef struct poiseuille_result {
+    sph_status status;
+    double centre;  /* (u - u_exact)/u_max, mean of the two rows beside y = H/2 [-]            */
+    double rms;     /* RMS over the rows of (u_row - u_exact(y_row)) / u_max [-]                */
+    double v_max;   /* largest |v_y| / u_max [-]                                                */
+    double ms_step; /* wall-clock milliseconds per sub-step                                     */
+    unsigned long long steps;
+} poiseuille_result;
+
+/* Fluid of rest density 1 between walls at y = 0 and y = H = 1 (the walls' particles start half
+   a spacing outside, so the no-slip plane is at 0 and H), N particles across, 0.5 m long and
+   periodic in x, nu = 0.5 m^2/s, g = 1 m/s^2 along x: u_max = g H^2 / (8 nu) = 0.25 m/s, Re =
+   u_max H / nu = 0.5. Sound speed 10 u_max. The slowest mode of the start-up decays as
+   exp(-pi^2 nu t / H^2) (Morris et al. 1997 eq. 22), 0.2 s: at t = 2.5 s it is e^-12 of its start,
+   far below 1e-3, so the profile is the steady one. */
+static poiseuille_result run_poiseuille(sph_solver solver, int N, double t_end) {
+    const double H = 1.0, L = 0.5, nu = 0.5, g = 1.0, umax = g * H * H / (8 * nu);
+    sph_world_def def = sph_world_def_default(2);
+    sph_world w;
+    sph_phase fluid;
+    sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)L, (sph_real)H};
+    poiseuille_result r;
+    double sum[80], cnt[80], t0;
+    size_t i;
+    int b;
+    memset(&r, 0, sizeof r);
+    def.spacing = (sph_real)(H / N);
+    def.solver = solver;
+    def.gravity[0] = (sph_real)g;
+    def.gravity[1] = 0;
+    def.wall = SPH_WALL_NO_SLIP;
+    def.periodic[0] = 1;
+    def.domain_lo[0] = 0;
+    def.domain_hi[0] = (sph_real)L;
+    memset(&fluid, 0, sizeof fluid);
+    fluid.rest_density = 1;
+    fluid.viscosity = (sph_real)nu;
+    fluid.sound_speed = (sph_real)(10 * umax);
+    if (sph_world_init(&w, &def) != SPH_OK || sph_world_add_phase(&w, &fluid) != 0 ||
+        sph_fill_box(&w, 0, lo, hi) != SPH_OK ||
+        sph_add_wall_box(&w, lo, hi, 0, SPH_FACE_XMIN | SPH_FACE_XMAX) != SPH_OK) {
+        th_fail(__FILE__, __LINE__, "channel setup: %s", w.error);
+        r.status = w.status;
+        return r;
+    }
+    t0 = (double)clock() / CLOCKS_PER_SEC;
+    r.status = sph_advance(&w, (sph_real)t_end);
+    r.steps = (unsigned long long)w.steps;
+    r.ms_step = 1e3 * ((double)clock() / CLOCKS_PER_SEC - t0) / (double)(w.steps ? w.steps : 1);
+    for (b = 0; b < N; ++b) sum[b] = cnt[b] = 0;
+    for (i = 0; i < w.n; ++i) {
+        b = (int)floor((double)w.x[2 * i + 1] / H * N);
+        if (b >= 0 && b < N) { sum[b] += (double)w.v[2 * i]; cnt[b] += 1; }
+        r.v_max = fmax(r.v_max, fabs((double)w.v[2 * i + 1]) / umax);
+    }
+    for (b = 0; b < N; ++b) {
+        const double y = (b + 0.5) * H / N, ue = g * y * (H - y) / (2 * nu);
+        const double e = cnt[b] > 0 ? (sum[b] / cnt[b] - ue) / umax : 1;
+        r.rms += e * e;
+        if (b == N / 2 - 1 || b == N / 2) r.centre += 0.5 * e;
+    }
+    r.rms = sqrt(r.rms / N);
+    sph_world_free(&w);
+    return r;
+}
+
+static const char* solver_label(sph_solver s) {
+    return s == SPH_SOLVER_WCSPH ? "WCSPH" : s == SPH_SOLVER_IISPH ? "IISPH"
+           : s == SPH_SOLVER_DFSPH ? "DFSPH" : s == SPH_SOLVER_PCISPH ? "PCISPH" : "other";
+}
+
+static void check_poiseuille(sph_solver solver, int N) {
+    const poiseuille_result r = run_poiseuille(solver, N, 2.5);
+    CHECK_MSG(r.status == SPH_OK, "%s Poiseuille: status %d", solver_label(solver), (int)r.status);
+    TH_NOTE("%s Poiseuille, %d across, t = 2.5 s: centre error %+.4f u_max, RMS %.4f u_max, "
+            "|v_y| <= %.1e u_max, %llu steps, %.3f ms per step", solver_label(solver), N,
+            r.centre, r.rms, r.v_max, r.steps, r.ms_step);
+    CHECK_LT(fabs(r.centre), 0.01);
+    CHECK_LT(r.rms, 0.01);
+    CHECK_LT(r.v_max, 0.01);
+}
+
+static void test_poiseuille_wcsph_20(void) { check_poiseuille(SPH_SOLVER_WCSPH, 20); }
+static void test_poiseuille_iisph_20(void) { check_poiseuille(SPH_SOLVER_IISPH, 20); }
+static void test_poiseuille_dfsph_20(void) { check_poiseuille(SPH_SOLVER_DFSPH, 20); }
+static void test_poiseuille_wcsph_40(void) { check_poiseuille(SPH_SOLVER_WCSPH, 40); }
+
+/* ---- Taylor-Green decay --------------------------------------------------------------------- */
+
+typedef struct decay_result {
+    sph_status status;
+    double ratio; /* measured decay rate of the kinetic energy / 16 pi^2 nu / L^2 [-]         */
+} decay_result;
+
+/* scene_taylor_green (unit periodic box, U = 1 m/s, nu = 0.01 m^2/s, c0 = 10 U) with the
+   library's default kernel and options, N x N particles, through sph_advance to t_end; the rate
+   is the least-squares slope of ln KE over samples every 0.05 s from t = 0.05 s (the first
+   steps of a weakly compressible start carry acoustic transients). alpha: the artificial
+   viscosity (def.alpha). */
+static decay_result run_taylor_green(sph_solver solver, int N, double alpha, double t_end) {
+    const double nu = 0.01, exact = 16 * SCENE_TG_PI * SCENE_TG_PI * nu;
+    sph_world_def def = sph_world_def_default(2);
+    sph_world w;
+    decay_result r;
+    double st = 0, sy = 0, stt = 0, sty = 0, ns = 0;
+    int k, frames = (int)(t_end / 0.05 + 0.5);
+    memset(&r, 0, sizeof r);
+    def.solver = solver;
+    def.alpha = (sph_real)alpha;
+    r.status = scene_taylor_green(&w, def, N, 10);
+    if (r.status != SPH_OK) {
+        th_fail(__FILE__, __LINE__, "Taylor-Green setup: %s", w.error);
+        return r;
+    }
+    for (k = 1; k <= frames && r.status == SPH_OK; ++k) {
+        double ke = 0;
+        size_t i;
+        r.status = sph_advance(&w, (sph_real)0.05);
+        for (i = 0; i < 2 * w.n; ++i) ke += 0.5 * (double)w.v[i] * (double)w.v[i];
+        if (ke <= 0) break;
+        st += w.time; sy += log(ke); stt += w.time * w.time; sty += w.time * log(ke); ns += 1;
+    }
+    if (r.status != SPH_OK) th_fail(__FILE__, __LINE__, "Taylor-Green: %s", w.error);
+    r.ratio = -(ns * sty - st * sy) / (ns * stt - st * st) / exact;
+    sph_world_free(&w);
+    return r;
+}
+
+static void test_taylor_green_decay(void) {
+    static const sph_solver solvers[] = {SPH_SOLVER_WCSPH, SPH_SOLVER_IISPH, SPH_SOLVER_DFSPH,
+                                         SPH_SOLVER_PCISPH};
+    int s;
+    for (s = 0; s < 4; ++s) {
+        const decay_result on = run_taylor_green(solvers[s], 40, 0.02, 0.5);
+        const decay_result off = run_taylor_green(solvers[s], 40, 0, 0.5);
+        TH_NOTE("%s Taylor-Green 40^2, t <= 0.5 s: decay rate / exact %.3f (alpha 0.02), %.3f "
+                "(alpha 0)", solver_label(solvers[s]), on.ratio, off.ratio);
+    }
+}
+
+const th_test tests_viscous[] = {
+    {"viscous/poiseuille_wcsph_20", test_poiseuille_wcsph_20},
+    {"viscous/poiseuille_iisph_20", test_poiseuille_iisph_20},
+    {"viscous/poiseuille_dfsph_20", test_poiseuille_dfsph_20},
+    {"viscous/taylor_green_decay", test_taylor_green_decay},
+    {0, 0},
+};
+
+const th_test tests_viscous_long[] = {
+    {"viscous-long/poiseuille_wcsph_40", test_poiseuille_wcsph_40},
+    {0, 0},
+};
