@@ -92,7 +92,8 @@ int main(void) {
    its slope still jumps by 7e-4 of its peak at 3h). All are normalised in 1D, 2D and 3D; W and
    its derivatives are exactly zero from the support radius on. Discrete sums are not exact: on
    a square lattice with Wendland C2 at h = 1.3 dx the pressure gradient is reproduced to 0.974
-   and Morris' Laplacian to 0.963 (a larger h_factor improves both at more neighbours).
+   and Morris' Laplacian to 0.963 (a larger h_factor improves both at more neighbours); the
+   laminar viscosity divides that factor out, measured per particle (see VISCOSITY).
 
    NEIGHBOUR GRID
    sph_grid sorts points into cells of the support radius with a counting sort. Cells are
@@ -121,13 +122,35 @@ int main(void) {
    2009, delta = 0.1), by summation (negative pressures then clamped), or by Ott & Schnetter's
    particle-density continuity for phases of very different density. Viscosity: Monaghan's
    artificial viscosity (alpha = 0.02 by default) and a laminar viscosity per phase (Morris et al.
-   1997 by default, or the 2(d+2) form of Enhanced PCISPH 2018 eq. 2.5). Time integration:
+   1997 by default, or the 2(d+2) form of Enhanced PCISPH 2018 eq. 2.5); see VISCOSITY below
+   (all solvers share the term). Time integration:
    symplectic Euler (default) or Stormer-Verlet (second order in time); both take two neighbour
    passes per step over one neighbour list (forces, then the density rate with the new velocities,
    which stable integration of the acoustic waves requires). sph_stable_dt combines the acoustic CFL
    (0.25 h / (c0 + |v|)), the viscous limit (0.125 h^2 / nu) and the force limit
    (0.25 sqrt(h / |a|)); sph_advance(&w, duration) steps with it, landing exactly on the end
    (see ERRORS for what it does when a step fails).
+
+   VISCOSITY (every solver but the second-order scheme, which has its own Laplacian)
+   sph_phase.viscosity is the kinematic viscosity nu [m^2/s]. The default form is Morris et al.
+   1997's Laplacian, divided by each particle's measured second moment m_i of the kernel gradient
+   over its fluid and wall neighbours (the sum that must be 1 for the term to be nu Lap v; 0.963
+   on a square lattice with Wendland C2 at h = 1.3 dx, at every resolution), pair factor
+   (1/m_i + 1/m_j)/2 so momentum stays conserved, 1/m_i at most 2 (free surfaces, splashes).
+   Measured through sph_advance (tests/test_viscous.c: plane Poiseuille between no-slip walls, Re
+   0.5): the centre speed is 0.8 % fast at 20 particles across and 0.5 % at 40 (RMS over the
+   profile 0.7 % and 0.4 %; without the normalisation 4.2 % and 3.9 %); the rest is the no-slip
+   wall, whose fluid rows slip by 0.5 % of u_max. It costs one light neighbour pass per viscous
+   pass. Numerical dissipation: a vortex filling a closed free-slip box (u = sin(pi x) cos(pi y),
+   nu = 0.01, 25 x 25, its exact kinetic energy decaying as exp(-4 pi^2 nu t)) follows the exact
+   decay until t = 0.2 s, then the lattice breaks up along the vortex's stretching directions (no
+   background pressure, no particle shifting: the disordered particles dissipate), and over
+   0.5 s the energy decays 4.2 (WCSPH), 2.9 (IISPH), 3.0 (DFSPH, PCISPH) times as fast as it
+   should. The default artificial viscosity is not the cause (alpha = 0 gives the same rates
+   within 4 %): alpha = 0.02 acts only on approaching pairs and adds about alpha c0 h / 16
+   (1.3 % of nu there); it stays, because it damps the acoustic noise of WCSPH's equation of
+   state and of impacts (the dam break and tank tests rely on it); set def.alpha = 0 for
+   a viscous flow that needs none.
 
    WCSPH, SECOND-ORDER SCHEME (def.scheme = SPH_SCHEME_SECOND_ORDER; periodic domains only)
    Negi & Ramachandran 2022, L-IPST-C: the fluid density rho (w->rho) is carried by
@@ -650,7 +673,8 @@ typedef enum sph_wcsph_scheme {
 
 typedef enum sph_viscosity_form {
     SPH_VISC_MORRIS = 0, /* Morris et al. 1997: sum_j m_j (mu_i + mu_j) x_ij.grad W_ij /
-                            (rho_i rho_j (r^2 + eta^2)) v_ij; accurate Laplacian (default)      */
+                            (rho_i rho_j (r^2 + eta^2)) v_ij, divided by the particles' measured
+                            second moments (see VISCOSITY at the top) (default)              */
     SPH_VISC_MONAGHAN    /* Monaghan 2005 / Enhanced PCISPH 2018 eq. 2.5: 2(d+2) ... (v_ij.x_ij)
                             grad W_ij; conserves angular momentum, less accurate on a lattice */
 } sph_viscosity_form;
@@ -3981,7 +4005,7 @@ static void sph__stage_eos(sph_world* w, const sph__ctx* c) {
 }
 
 /* The normalisation of Morris' Laplacian, per fluid particle (laminar viscosity, SPH_VISC_MORRIS).
-   Morris et al. 1997's term (eq. 8; see VISCOUS below) for particle i is sum_j K_ij (v_i - v_j),
+   Morris et al. 1997's term (see VISCOUS below) for particle i is sum_j K_ij (v_i - v_j),
    K_ij = m_j (mu_i + mu_j)/(rho_i rho_j) F_ij r_ij^2/(r_ij^2 + eta^2), grad W_ij = F_ij x_ij
    (F < 0). On a field with Hessian H (v_j - v_i = x_ji . grad v + 1/2 x_ji x_ji : H + ...), where
    the neighbourhood's first moment vanishes, it gives nu T_i : H with the second-moment tensor
@@ -3997,14 +4021,16 @@ static void sph__stage_eos(sph_world* w, const sph__ctx* c) {
    the boundary condition), and the viscous term uses the pair factor (1/m_i + 1/m_j)/2 (1/m_i
    against walls). Then a quadratic field's Laplacian is reproduced wherever T_i is isotropic;
    the factor is symmetric in i and j, so fluid-fluid forces stay pairwise antisymmetric and
-   momentum is conserved as before; it tends to 1 as h/dx grows (it is measured, not a lattice
-   constant), and costs one light neighbour pass per viscous pass (no velocities, no division
-   per pair). A particle with a truncated neighbourhood (free surface, splash) has m_i < 1: the
-   correction then also restores the part of the Laplacian its missing neighbours took (at a
-   zero-stress surface 0.48 -> 0.87 of it on a lattice), but m_i -> 0 for a particle with only
-   far or no neighbours, so 1/m_i is bounded by 2: the largest eigenvalue of the viscous operator
-   grows at most twice, within the margin of def.cfl_viscous (stable to 0.29 h^2/nu for this form,
-   see sph_stable_dt; the default is 0.125). [writes w->priv.lapc, 1 / m_i] */
+   momentum is conserved as before; m_i tends to 1 as h/dx grows (it is measured, not a lattice
+   constant), and the pass is a light neighbour loop (positions and densities, no velocities)
+   before each viscous pass. A particle with a truncated neighbourhood (free surface, splash) has m_i < 1, and
+   the correction also restores part of what its missing neighbours took: on the top row of a
+   square lattice (Wendland C2, h = 1.3 dx) m = 0.62, and the term gives 0.78 instead of 0.48 of
+   the Laplacian of u(y) across the surface, 1.22 instead of 0.75 along it. m_i -> 0 for a
+   particle with only far or no neighbours, so 1/m_i is bounded by 2: the largest eigenvalue of
+   the viscous operator grows at most twice (1/0.963 in a lattice's interior), within the margin
+   of def.cfl_viscous (a lattice is stable to dt = 0.29 h^2/nu for this form without the factor,
+   see sph_stable_dt, so to 0.145 with the bound; the default is 0.125). [writes w->priv.lapc, 1 / m_i] */
 static int sph__visc_norm_used(const sph_world* w) {
     int q;
     if (w->def.viscosity_form != SPH_VISC_MORRIS) return 0;
@@ -4073,7 +4099,8 @@ enum { SPH__PRESSURE = 1, SPH__VISCOUS = 2, SPH__RATE = 4, SPH__SET = 8, SPH__CA
           (extrapolated; mirrored p_b = p_i, rho_b = rho_i; or p_b = 0). [m/s^2]
    VISCOUS: laminar viscosity (Morris et al. 1997: sum_j m_j (mu_i + mu_j)/(rho_i rho_j)
           x_ij.grad W_ij/(r^2+eta^2) v_ij, which needs only the second moment of grad W to give
-          nu Lap v, 0.96 of it on a lattice with Wendland C2 at h = 1.3 dx; or Monaghan 2005 /
+          nu Lap v, 0.96 of it on a lattice with Wendland C2 at h = 1.3 dx, so each pair is
+          multiplied by (1/m_i + 1/m_j)/2, m the measured moment (sph__stage_visc_norm); or Monaghan 2005 /
           Enhanced PCISPH 2018 eq. 2.5, 2(d+2) sum_j m_j nu_bar/rho_bar v_ij.x_ij/(r^2+eta^2) grad
           W, which conserves angular momentum but needs the fourth moment: 0.80 of nu Lap v on the
           same lattice) and Monaghan 1992 artificial viscosity Pi_ij = (-alpha c_bar mu_ij +

@@ -1,13 +1,15 @@
 /* tests/test_viscous.c - viscous accuracy through sph_advance with the defaults (issue 18):
    - plane Poiseuille flow between no-slip walls, periodic in x, driven by a body force g: the
-     steady profile u(y) = g y (H - y) / (2 nu) (Morris, Fox & Zhu 1997 sec. 4.1), centre speed
+     steady profile u(y) = g y (H - y) / (2 nu) (Morris, Fox & Zhu 1997 validate their viscous term on it), centre speed
      and RMS over the profile at 20 particles across (and 40 in the long set: the error must not
      grow with resolution), WCSPH, IISPH and DFSPH;
-   - the periodic Taylor-Green vortex: its kinetic energy decays as exp(-16 pi^2 nu t / L^2)
-     (u = -U e^{bt} cos(2 pi x/L) sin(2 pi y/L), v = U e^{bt} sin(2 pi x/L) cos(2 pi y/L) solves
-     the Navier-Stokes equations with b = -8 pi^2 nu / L^2: the nonlinear term is a gradient,
-     balanced by the pressure, and nu Lap u = -8 pi^2 nu / L^2 u; the kinetic energy goes with
-     e^{2bt}); the measured decay rate per solver against that. */
+   - a Taylor-Green vortex cell filling a closed free-slip box: its kinetic energy decays as
+     exp(-4 pi^2 nu t / L^2) (see run_box_decay); the measured decay rate per solver, with the
+     default artificial viscosity and without. (The periodic Taylor-Green box of
+     scene_taylor_green, wavelength L, decays as exp(-16 pi^2 nu t / L^2); with the standard
+     options and c0 = 10 U, IISPH and DFSPH blow up in it by t = 0.1 s and WCSPH and PCISPH
+     decay 4.1 and 3.6 times too fast at 40 x 40, so it is the second-order scheme's test,
+     tests/test_soc.c.) */
 #include "harness.h"
 #include "../sph.h"
 #include "../examples/scenes.h"
@@ -32,7 +34,7 @@ typedef struct poiseuille_result {
    a spacing outside, so the no-slip plane is at 0 and H), N particles across, 0.5 m long and
    periodic in x, nu = 0.5 m^2/s, g = 1 m/s^2 along x: u_max = g H^2 / (8 nu) = 0.25 m/s, Re =
    u_max H / nu = 0.5. Sound speed 10 u_max. The slowest mode of the start-up decays as
-   exp(-pi^2 nu t / H^2) (Morris et al. 1997 eq. 22), 0.2 s: at t = 2.5 s it is e^-12 of its start,
+   exp(-pi^2 nu t / H^2) (the first term of the series solution), 0.2 s: at t = 2.5 s it is e^-12 of its start,
    far below 1e-3, so the profile is the steady one. */
 static poiseuille_result run_poiseuille(sph_solver solver, int N, double t_end) {
     const double H = 1.0, L = 0.5, nu = 0.5, g = 1.0, umax = g * H * H / (8 * nu);
@@ -106,56 +108,91 @@ static void test_poiseuille_iisph_20(void) { check_poiseuille(SPH_SOLVER_IISPH, 
 static void test_poiseuille_dfsph_20(void) { check_poiseuille(SPH_SOLVER_DFSPH, 20); }
 static void test_poiseuille_wcsph_40(void) { check_poiseuille(SPH_SOLVER_WCSPH, 40); }
 
-/* ---- Taylor-Green decay --------------------------------------------------------------------- */
+/* ---- a decaying vortex in a closed box ----------------------------------------------------- */
 
 typedef struct decay_result {
     sph_status status;
-    double ratio; /* measured decay rate of the kinetic energy / 16 pi^2 nu / L^2 [-]         */
+    double ratio; /* measured decay rate of the kinetic energy / exact rate 4 pi^2 nu / L^2 [-] */
+    double ke;    /* KE(t_end) / KE(0) [-]                                                     */
 } decay_result;
 
-/* scene_taylor_green (unit periodic box, U = 1 m/s, nu = 0.01 m^2/s, c0 = 10 U) with the
-   library's default kernel and options, N x N particles, through sph_advance to t_end; the rate
-   is the least-squares slope of ln KE over samples every 0.05 s from t = 0.05 s (the first
-   steps of a weakly compressible start carry acoustic transients). alpha: the artificial
-   viscosity (def.alpha). */
-static decay_result run_taylor_green(sph_solver solver, int N, double alpha, double t_end) {
-    const double nu = 0.01, exact = 16 * SCENE_TG_PI * SCENE_TG_PI * nu;
+/* A unit box of water (rest density 1000, nu = 0.01 m^2/s, no gravity) completely filled, walls
+   with the defaults (free slip), u = U sin(pi x) cos(pi y), v = -U cos(pi x) sin(pi y), U = 1 m/s:
+   a Taylor-Green cell of wavelength 2 L. The walls carry no normal velocity and no shear stress
+   (dv/dx = 0 at x = 0, L), so the free-slip box holds the periodic solution exactly: nu Lap u =
+   -2 pi^2 nu / L^2 u, and the kinetic energy decays as exp(-4 pi^2 nu t / L^2) (0.395 /s; the
+   nonlinear term is a gradient the pressure balances). The scene of tests/test_scenes.c's box.
+   Through sph_advance with the defaults; the rate is the least-squares slope of ln KE over
+   samples every 0.05 s. alpha: def.alpha (artificial viscosity; default 0.02). */
+static decay_result run_box_decay(sph_solver solver, int N, double alpha, double t_end) {
+    const double nu = 0.01, L = 1, exact = 4 * SCENE_TG_PI * SCENE_TG_PI * nu / (L * L);
     sph_world_def def = sph_world_def_default(2);
     sph_world w;
+    sph_phase water;
+    sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)L, (sph_real)L};
     decay_result r;
-    double st = 0, sy = 0, stt = 0, sty = 0, ns = 0;
-    int k, frames = (int)(t_end / 0.05 + 0.5);
+    double st = 0, sy = 0, stt = 0, sty = 0, ns = 0, ke0 = 0, ke = 0;
+    int f, frames = (int)(t_end / 0.05 + 0.5);
+    size_t i;
     memset(&r, 0, sizeof r);
+    memset(&water, 0, sizeof water);
+    water.rest_density = 1000;
+    water.viscosity = (sph_real)nu;
+    if (solver == SPH_SOLVER_PCISPH) sph_world_def_pcisph(&def, 0);
     def.solver = solver;
     def.alpha = (sph_real)alpha;
-    r.status = scene_taylor_green(&w, def, N, 10);
-    if (r.status != SPH_OK) {
-        th_fail(__FILE__, __LINE__, "Taylor-Green setup: %s", w.error);
+    def.spacing = (sph_real)(L / N);
+    def.gravity[1] = 0;
+    if (sph_world_init(&w, &def) != SPH_OK || sph_world_add_phase(&w, &water) != 0 ||
+        sph_fill_box(&w, 0, lo, hi) != SPH_OK || sph_add_wall_box(&w, lo, hi, 0, 0) != SPH_OK) {
+        th_fail(__FILE__, __LINE__, "box setup: %s", w.error);
+        r.status = w.status;
         return r;
     }
-    for (k = 1; k <= frames && r.status == SPH_OK; ++k) {
-        double ke = 0;
-        size_t i;
+    for (i = 0; i < w.n; ++i) {
+        const double x = (double)w.x[2 * i] / L, y = (double)w.x[2 * i + 1] / L;
+        w.v[2 * i] = (sph_real)(sin(SCENE_TG_PI * x) * cos(SCENE_TG_PI * y));
+        w.v[2 * i + 1] = (sph_real)(-cos(SCENE_TG_PI * x) * sin(SCENE_TG_PI * y));
+    }
+    for (i = 0; i < 2 * w.n; ++i) ke0 += 0.5 * (double)w.v[i] * (double)w.v[i];
+    st = 0; sy = log(ke0); stt = 0; sty = 0; ns = 1;
+    for (f = 1; f <= frames && r.status == SPH_OK; ++f) {
         r.status = sph_advance(&w, (sph_real)0.05);
+        ke = 0;
         for (i = 0; i < 2 * w.n; ++i) ke += 0.5 * (double)w.v[i] * (double)w.v[i];
-        if (ke <= 0) break;
         st += w.time; sy += log(ke); stt += w.time * w.time; sty += w.time * log(ke); ns += 1;
     }
-    if (r.status != SPH_OK) th_fail(__FILE__, __LINE__, "Taylor-Green: %s", w.error);
+    if (r.status != SPH_OK) th_fail(__FILE__, __LINE__, "box decay: %s", w.error);
     r.ratio = -(ns * sty - st * sy) / (ns * stt - st * st) / exact;
+    r.ke = ke / ke0;
     sph_world_free(&w);
     return r;
 }
 
-static void test_taylor_green_decay(void) {
+/* Per solver with the defaults, over 0.5 s at 25 x 25: the kinetic energy decays at least at the
+   physical rate (ratio >= 0.9: a viscous term that lost part of its Laplacian, or walls that
+   added energy, would show), and the default artificial viscosity (alpha = 0.02) changes the
+   rate by at most 0.15 of the physical one (it is not what makes the decay too fast). The
+   upper bounds are the known excess (measured 4.2 WCSPH, 2.9 IISPH, 3.0 DFSPH and PCISPH): the
+   lattice breaks up along the stretching directions after t = 0.2 s and the disordered
+   particles dissipate; they hold it from growing unnoticed, they do not call it right. */
+static void test_box_decay(void) {
     static const sph_solver solvers[] = {SPH_SOLVER_WCSPH, SPH_SOLVER_IISPH, SPH_SOLVER_DFSPH,
                                          SPH_SOLVER_PCISPH};
+    static const double known_excess[] = {4.6, 3.3, 3.4, 3.4};
     int s;
     for (s = 0; s < 4; ++s) {
-        const decay_result on = run_taylor_green(solvers[s], 40, 0.02, 0.5);
-        const decay_result off = run_taylor_green(solvers[s], 40, 0, 0.5);
-        TH_NOTE("%s Taylor-Green 40^2, t <= 0.5 s: decay rate / exact %.3f (alpha 0.02), %.3f "
-                "(alpha 0)", solver_label(solvers[s]), on.ratio, off.ratio);
+        const decay_result on = run_box_decay(solvers[s], 25, 0.02, 0.5);
+        const decay_result off = run_box_decay(solvers[s], 25, 0, 0.5);
+        TH_NOTE("%s vortex box 25^2, t <= 0.5 s: decay rate / exact %.3f (alpha 0.02, KE %.3f), "
+                "%.3f (alpha 0, KE %.3f); exact KE %.3f", solver_label(solvers[s]), on.ratio,
+                on.ke, off.ratio, off.ke, exp(-4 * SCENE_TG_PI * SCENE_TG_PI * 0.01 * 0.5));
+        CHECK_EQ_INT(on.status, SPH_OK);
+        CHECK_EQ_INT(off.status, SPH_OK);
+        CHECK_LE(0.9, on.ratio);
+        CHECK_LE(0.9, off.ratio);
+        CHECK_LT(fabs(on.ratio - off.ratio), 0.15);
+        CHECK_LT(on.ratio, known_excess[s]);
     }
 }
 
@@ -163,7 +200,7 @@ const th_test tests_viscous[] = {
     {"viscous/poiseuille_wcsph_20", test_poiseuille_wcsph_20},
     {"viscous/poiseuille_iisph_20", test_poiseuille_iisph_20},
     {"viscous/poiseuille_dfsph_20", test_poiseuille_dfsph_20},
-    {"viscous/taylor_green_decay", test_taylor_green_decay},
+    {"viscous/box_decay", test_box_decay},
     {0, 0},
 };
 
