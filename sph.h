@@ -4046,42 +4046,48 @@ SPH__INLINE sph_real sph__wall_kappa(const sph__ctx* c, size_t b, size_t i, sph_
     return c->bp_mode == SPH_BP_EXTRAPOLATE ? c->brho[b] : rhati;
 }
 
+/* m_i for one particle; D a compile-time constant (the pass is specialised per dimension, as
+   sph__stage_interact's are: the loop over k unrolls and d[] stays in registers). */
+SPH__INLINE sph_real sph__visc_norm_one(const sph__ctx* c, size_t i, const int D) {
+    const sph_real* xi = c->x + i * (size_t)D;
+    const sph_real rhati = c->rho[i] * c->pc[c->ph[i]].inv_rho0;
+    const int per = c->periodic_any, form = c->k.form;
+    sph_real S = 0; /* sum_j V_j (-F_ij) r^4/(r^2 + eta^2) = d m_i, without the factor norm_g */
+    size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
+    int k;
+    for (kk = k0; kk < k1; ++kk) {
+        const size_t j = c->ff->idx[kk];
+        const sph_real mj = c->m ? c->m[j] : c->m0;
+        sph_real d[3] = {0, 0, 0}, r2 = 0;
+        sph__delta_vec_p(c, per, xi, c->x + j * (size_t)D, d, D);
+        SPH__FOR_K(D, r2 += d[k] * d[k]);
+        S -= mj / c->rho[j] * sph__kf(form, sph__sqrt(r2) * c->k.inv_h) * r2 * r2 / (r2 + c->eta2);
+    }
+    if (c->has_b) {
+        k0 = c->fb->begin[i];
+        k1 = k0 + c->fb->count[i];
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t b = c->fb->idx[kk];
+            sph_real d[3] = {0, 0, 0}, r2 = 0;
+            sph__delta_vec_p(c, per, xi, c->bx + b * (size_t)D, d, D);
+            SPH__FOR_K(D, r2 += d[k] * d[k]);
+            S -= c->bvol[b] / sph__wall_kappa(c, b, i, rhati) *
+                 sph__kf(form, sph__sqrt(r2) * c->k.inv_h) * r2 * r2 / (r2 + c->eta2);
+        }
+    }
+    return S * c->k.norm_g / (sph_real)D;
+}
+
 static void sph__stage_visc_norm(sph_world* w, const sph__ctx* c) {
     const int D = c->dim;
-    const sph_real inv_d = 1 / (sph_real)D;
-    sph__idx ii;
+    sph__idx i;
     SPH_ASSERT(c->lapc && w->priv.lapc_cap >= w->n);
     SPH__OMP_FOR(w->n)
-    for (ii = 0; ii < (sph__idx)w->n; ++ii) {
-        const size_t i = (size_t)ii;
-        const sph_real* xi = c->x + i * (size_t)D;
-        const sph_real rhati = c->rho[i] * c->pc[c->ph[i]].inv_rho0;
-        sph_real S = 0; /* sum_j V_j (-F_ij) r^4/(r^2 + eta^2) = d m_i */
-        size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
-        int k;
-        for (kk = k0; kk < k1; ++kk) {
-            const size_t j = c->ff->idx[kk];
-            const sph_real mj = c->m ? c->m[j] : c->m0;
-            sph_real d[3] = {0, 0, 0}, r2 = 0;
-            sph__delta_vec(c, xi, c->x + j * (size_t)D, d, D);
-            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
-            S -= mj / c->rho[j] * c->k.norm_g * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h) *
-                 r2 * r2 / (r2 + c->eta2);
-        }
-        if (c->has_b) {
-            k0 = c->fb->begin[i];
-            k1 = k0 + c->fb->count[i];
-            for (kk = k0; kk < k1; ++kk) {
-                const size_t b = c->fb->idx[kk];
-                sph_real d[3] = {0, 0, 0}, r2 = 0;
-                sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
-                for (k = 0; k < D; ++k) r2 += d[k] * d[k];
-                S -= c->bvol[b] / sph__wall_kappa(c, b, i, rhati) * c->k.norm_g *
-                     sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h) * r2 * r2 / (r2 + c->eta2);
-            }
-        }
-        S *= inv_d; /* m_i */
-        w->priv.lapc[i] = S > SPH__R(0.5) ? 1 / S : 2;
+    for (i = 0; i < (sph__idx)w->n; ++i) {
+        const sph_real m = D == 2 ? sph__visc_norm_one(c, (size_t)i, 2)
+                         : D == 3 ? sph__visc_norm_one(c, (size_t)i, 3)
+                                  : sph__visc_norm_one(c, (size_t)i, 1);
+        w->priv.lapc[i] = m > SPH__R(0.5) ? 1 / m : 2;
     }
 }
 

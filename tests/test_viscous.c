@@ -13,11 +13,15 @@
 #include "harness.h"
 #include "../sph.h"
 #include "../examples/scenes.h"
+#include "state_hash.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 /* ---- plane Poiseuille flow ------------------------------------------------------------------ */
 
@@ -196,11 +200,128 @@ static void test_box_decay(void) {
     }
 }
 
+/* ---- conservation and determinism of the normalised term ------------------------------------ */
+
+/* A periodic box of viscous fluid (nu = 0.05 m^2/s, no walls, no gravity) on a lattice shaken by
+   up to 0.025 dx, so every particle's moment m_i differs, with a sheared velocity field: the pair
+   factor (1/m_i + 1/m_j)/2 is symmetric, so the forces are pairwise antisymmetric and the total
+   momentum stays at its start to round-off (relative to sum m |v|) over 20 steps, per solver
+   (1/m_i alone in place of the pair factor leaves 3e-7 ... 7e-6 of it). */
+static void test_momentum_conserved(void) {
+    static const sph_solver solvers[] = {SPH_SOLVER_WCSPH, SPH_SOLVER_IISPH, SPH_SOLVER_DFSPH};
+    int s;
+    for (s = 0; s < 3; ++s) {
+        sph_world_def def = sph_world_def_default(2);
+        sph_world w;
+        sph_phase fluid;
+        sph_real lo[2] = {0, 0}, hi[2] = {1, 1};
+        double p0[2] = {0, 0}, p1[2] = {0, 0}, scale = 0, lcg = 1;
+        size_t i;
+        int k;
+        memset(&fluid, 0, sizeof fluid);
+        fluid.rest_density = 1;
+        fluid.viscosity = (sph_real)0.05;
+        fluid.sound_speed = 10;
+        def.solver = solvers[s];
+        def.spacing = (sph_real)(1.0 / 30);
+        def.gravity[1] = 0;
+        for (k = 0; k < 2; ++k) {
+            def.periodic[k] = 1;
+            def.domain_lo[k] = 0;
+            def.domain_hi[k] = 1;
+        }
+        CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
+        CHECK(sph_world_add_phase(&w, &fluid) == 0);
+        CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
+        for (i = 0; i < w.n; ++i) {
+            for (k = 0; k < 2; ++k) { /* a linear congruential sequence: the same in every build */
+                lcg = fmod(lcg * 16807.0, 2147483647.0);
+                w.x[2 * i + (size_t)k] += (sph_real)(0.05 * (lcg / 2147483647.0 - 0.5) * (double)w.dx);
+            }
+            w.v[2 * i] = (sph_real)(0.3 + sin(2 * SCENE_TG_PI * (double)w.x[2 * i + 1]));
+            w.v[2 * i + 1] = (sph_real)(0.5 * cos(2 * SCENE_TG_PI * (double)w.x[2 * i]));
+        }
+        for (i = 0; i < w.n; ++i)
+            for (k = 0; k < 2; ++k) p0[k] += (double)w.mass * (double)w.v[2 * i + (size_t)k];
+        for (k = 0; k < 20; ++k) {
+            sph_status st = th_step(&w, (sph_real)2e-4);
+            CHECK_MSG(st == SPH_OK, "%s: %s", solver_label(solvers[s]), w.error);
+            if (st != SPH_OK) break;
+        }
+        for (i = 0; i < w.n; ++i)
+            for (k = 0; k < 2; ++k) {
+                p1[k] += (double)w.mass * (double)w.v[2 * i + (size_t)k];
+                scale += (double)w.mass * fabs((double)w.v[2 * i + (size_t)k]);
+            }
+        TH_NOTE("%s periodic shaken box, nu = 0.05, 20 steps: |P - P0| / sum m|v| = %.2g, %.2g",
+                solver_label(solvers[s]), fabs(p1[0] - p0[0]) / scale, fabs(p1[1] - p0[1]) / scale);
+        CHECK_LT(fabs(p1[0] - p0[0]) / scale, 100 * TH_EPS);
+        CHECK_LT(fabs(p1[1] - p0[1]) / scale, 100 * TH_EPS);
+        sph_world_free(&w);
+    }
+}
+
+/* The normalisation pass is a gather like every other: 1 and 2 threads give bitwise the same
+   state (the no-slip vortex box at 60 x 60, above the 2048 particles of the serial cutoff, 10
+   steps, WCSPH and IISPH). */
+static uint64_t viscous_box_hash(sph_solver solver, int threads) {
+    sph_world_def def = sph_world_def_default(2);
+    sph_world w;
+    sph_phase water;
+    sph_real lo[2] = {0, 0}, hi[2] = {1, 1};
+    uint64_t hash;
+    size_t i;
+    int k;
+#ifdef _OPENMP
+    omp_set_num_threads(threads);
+#else
+    (void)threads;
+#endif
+    memset(&water, 0, sizeof water);
+    water.rest_density = 1000;
+    water.viscosity = (sph_real)0.01;
+    water.sound_speed = 10;
+    def.solver = solver;
+    def.spacing = (sph_real)(1.0 / 60);
+    def.gravity[1] = 0;
+    def.wall = SPH_WALL_NO_SLIP;
+    CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
+    CHECK(sph_world_add_phase(&w, &water) == 0);
+    CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
+    CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 0, 0), SPH_OK);
+    for (i = 0; i < w.n; ++i) {
+        const double x = (double)w.x[2 * i], y = (double)w.x[2 * i + 1];
+        w.v[2 * i] = (sph_real)(sin(SCENE_TG_PI * x) * cos(SCENE_TG_PI * y));
+        w.v[2 * i + 1] = (sph_real)(-cos(SCENE_TG_PI * x) * sin(SCENE_TG_PI * y));
+    }
+    for (k = 0; k < 10; ++k) CHECK_EQ_INT(th_step(&w, sph_stable_dt(&w, solver)), SPH_OK);
+    CHECK(w.n > 2048);
+    hash = th_state_hash(&w);
+    sph_world_free(&w);
+    return hash;
+}
+
+static void test_threads_bitwise(void) {
+#ifdef _OPENMP
+    static const sph_solver solvers[] = {SPH_SOLVER_WCSPH, SPH_SOLVER_IISPH};
+    int s;
+    for (s = 0; s < 2; ++s) {
+        const uint64_t h1 = viscous_box_hash(solvers[s], 1), h2 = viscous_box_hash(solvers[s], 2);
+        CHECK_MSG(h1 == h2, "%s: 1 and 2 threads differ", solver_label(solvers[s]));
+    }
+    omp_set_num_threads(omp_get_num_procs());
+#else
+    TH_SKIP("built without OpenMP");
+#endif
+}
+
 const th_test tests_viscous[] = {
     {"viscous/poiseuille_wcsph_20", test_poiseuille_wcsph_20},
     {"viscous/poiseuille_iisph_20", test_poiseuille_iisph_20},
     {"viscous/poiseuille_dfsph_20", test_poiseuille_dfsph_20},
     {"viscous/box_decay", test_box_decay},
+    {"viscous/momentum_conserved", test_momentum_conserved},
+    {"viscous/threads_bitwise", test_threads_bitwise},
     {0, 0},
 };
 
