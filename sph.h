@@ -92,7 +92,8 @@ int main(void) {
    its slope still jumps by 7e-4 of its peak at 3h). All are normalised in 1D, 2D and 3D; W and
    its derivatives are exactly zero from the support radius on. Discrete sums are not exact: on
    a square lattice with Wendland C2 at h = 1.3 dx the pressure gradient is reproduced to 0.974
-   and Morris' Laplacian to 0.963 (a larger h_factor improves both at more neighbours).
+   and Morris' Laplacian to 0.963 (a larger h_factor improves both at more neighbours); the
+   laminar viscosity divides that factor out, measured per particle (see VISCOSITY).
 
    NEIGHBOUR GRID
    sph_grid sorts points into cells of the support radius with a counting sort. Cells are
@@ -121,13 +122,38 @@ int main(void) {
    2009, delta = 0.1), by summation (negative pressures then clamped), or by Ott & Schnetter's
    particle-density continuity for phases of very different density. Viscosity: Monaghan's
    artificial viscosity (alpha = 0.02 by default) and a laminar viscosity per phase (Morris et al.
-   1997 by default, or the 2(d+2) form of Enhanced PCISPH 2018 eq. 2.5). Time integration:
+   1997 by default, or the 2(d+2) form of Enhanced PCISPH 2018 eq. 2.5); see VISCOSITY below
+   (all solvers share the term). Time integration:
    symplectic Euler (default) or Stormer-Verlet (second order in time); both take two neighbour
    passes per step over one neighbour list (forces, then the density rate with the new velocities,
    which stable integration of the acoustic waves requires). sph_stable_dt combines the acoustic CFL
    (0.25 h / (c0 + |v|)), the viscous limit (0.125 h^2 / nu) and the force limit
    (0.25 sqrt(h / |a|)); sph_advance(&w, duration) steps with it, landing exactly on the end
    (see ERRORS for what it does when a step fails).
+
+   VISCOSITY (every solver but the second-order scheme, which has its own Laplacian)
+   sph_phase.viscosity is the kinematic viscosity nu [m^2/s]. The default form is Morris et al.
+   1997's Laplacian, divided by each particle's measured second moment m_i of the kernel gradient
+   over its fluid and wall neighbours (the sum that must be 1 for the term to be nu Lap v; 0.963
+   on a square lattice with Wendland C2 at h = 1.3 dx, at every resolution), pair factor
+   (1/m_i + 1/m_j)/2 so momentum stays conserved, 1/m_i at most 2 (free surfaces, splashes).
+   Measured through sph_advance (tests/test_viscous.c: plane Poiseuille between no-slip walls, Re
+   0.5): the centre speed is 0.8 % fast at 20 particles across and 0.5 % at 40 (RMS over the
+   profile 0.7 % and 0.4 %; without the normalisation 4.2 % and 3.9 %); the rest is the no-slip
+   wall, whose fluid rows slip by 0.5 % of u_max (a wall-free periodic shear flow u = sin(2 pi y)
+   comes out 1.5 % and 0.65 % fast at 20 and 40 per wavelength, 5.0 % and 4.1 % before). It
+   costs one light neighbour pass per viscous pass: a 2D WCSPH step of a viscous 10k-particle box
+   takes 23 % more CPU time, IISPH's step (36 iterations there) no measurable more. Numerical
+   dissipation: a vortex filling a closed free-slip box (u = sin(pi x) cos(pi y), nu = 0.01,
+   25 x 25, its exact kinetic energy decaying as exp(-4 pi^2 nu t)) keeps WCSPH's energy within
+   3.5 % of the exact until t = 0.2 s; then the lattice breaks up along the vortex's stretching
+   directions (no background pressure, no particle shifting: the disordered particles
+   dissipate), and over 0.5 s the energy decays 4.2 (WCSPH), 2.9 (IISPH), 3.0 (DFSPH, PCISPH)
+   times as fast as it should. The default artificial viscosity is not the cause: with
+   alpha = 0 the rates change by at most 0.11 of the exact rate (4.22, 2.78, 3.09, 3.00). It
+   acts only on approaching pairs and is worth about alpha c0 h / 16 (6 % of nu there); it stays
+   at 0.02 because it damps the acoustic noise of WCSPH's equation of state and of impacts (the
+   dam-break and tank tests run with it); set def.alpha = 0 for a viscous flow that needs none.
 
    WCSPH, SECOND-ORDER SCHEME (def.scheme = SPH_SCHEME_SECOND_ORDER; periodic domains only)
    Negi & Ramachandran 2022, L-IPST-C: the fluid density rho (w->rho) is carried by
@@ -667,7 +693,8 @@ typedef enum sph_wcsph_scheme {
 
 typedef enum sph_viscosity_form {
     SPH_VISC_MORRIS = 0, /* Morris et al. 1997: sum_j m_j (mu_i + mu_j) x_ij.grad W_ij /
-                            (rho_i rho_j (r^2 + eta^2)) v_ij; accurate Laplacian (default)      */
+                            (rho_i rho_j (r^2 + eta^2)) v_ij, divided by the particles' measured
+                            second moments (see VISCOSITY at the top) (default)              */
     SPH_VISC_MONAGHAN    /* Monaghan 2005 / Enhanced PCISPH 2018 eq. 2.5: 2(d+2) ... (v_ij.x_ij)
                             grad W_ij; conserves angular momentum, less accurate on a lattice */
 } sph_viscosity_form;
@@ -961,6 +988,9 @@ typedef struct sph__private {
     size_t soc_cap;
     sph_real* socw;                 /* second-order scheme: omega_j B_i grad W_ij per listed pair   */
     size_t socw_cap;
+    sph_real* lapc;                 /* laminar viscosity (Morris form): each fluid particle's
+                                       Laplacian normalisation 1 / m_i (sph__stage_visc_norm)      */
+    size_t lapc_cap;
     sph_grid sgrid;                 /* second-order scheme: grid and lists at stage and shifted
                                        positions (the particles are not reordered mid-step)      */
     sph_neighbors snl;
@@ -2715,6 +2745,7 @@ SPHDEF void sph_world_free(sph_world* w) {
     SPH_FREE(w->priv.bpq);
     SPH_FREE(w->priv.soc);
     SPH_FREE(w->priv.socw);
+    SPH_FREE(w->priv.lapc);
     SPH_FREE(w->priv.snap[0]);
     SPH_FREE(w->priv.snap[1]);
     sph_grid_free(&w->priv.sgrid);
@@ -3312,7 +3343,8 @@ SPHDEF size_t sph_world_memory(const sph_world* w) {
               w->priv.df_kv_cap + w->priv.df_pv_cap +
               w->priv.ff_fw_cap + w->priv.fb_fw_cap + w->priv.pr2_cap + w->priv.vol_cap +
               w->priv.xp_cap +
-              w->priv.vp_cap + w->priv.de_cap + w->priv.cs_cap + w->priv.vn_cap + w->priv.bpq_cap + w->priv.soc_cap + w->priv.socw_cap) *
+              w->priv.vp_cap + w->priv.de_cap + w->priv.cs_cap + w->priv.vn_cap + w->priv.bpq_cap + w->priv.soc_cap + w->priv.socw_cap +
+              w->priv.lapc_cap) *
                  sizeof(sph_real);
     return bytes;
 }
@@ -3429,6 +3461,8 @@ typedef struct sph__ctx {
                                   average of the fluid's (solvers without one; Enhanced PCISPH
                                   2018 sec. 3.2.3)                                               */
     sph_real alpha, beta, delta, visc_k;
+    sph_real* lapc;            /* laminar viscosity, Morris form: 1 / m_i per fluid particle
+                                  (sph__stage_visc_norm fills it before each viscous pass)      */
     sph_real g[3];
     /* the compressible step */
     const sph_real* e;         /* specific internal energy (NULL without gas phases)             */
@@ -3497,6 +3531,7 @@ static void sph__ctx_init(sph_world* w, sph__ctx* c) {
        visc_k = d + 2. */
     c->visc_k = (sph_real)(w->dim + 2);
     if (c->morris) c->visc_k = 1;
+    if (c->laminar && c->morris) c->lapc = w->priv.lapc; /* reserved by sph__step_begin */
 }
 
 /* for (k = 0; k < D; ++k) STMT, written out for a compile-time D: each index is then a constant,
@@ -3783,6 +3818,7 @@ static sph_status sph__scratch(sph_world* w, sph_real** p, size_t count) {
                   : p == &w->priv.bpq   ? &w->priv.bpq_cap
                   : p == &w->priv.soc   ? &w->priv.soc_cap
                   : p == &w->priv.socw  ? &w->priv.socw_cap
+                  : p == &w->priv.lapc  ? &w->priv.lapc_cap
                                         : NULL;
     SPH_ASSERT(cap);
     if (count <= *cap && *p) return SPH_OK;
@@ -3988,6 +4024,93 @@ static void sph__stage_eos(sph_world* w, const sph__ctx* c) {
     }
 }
 
+/* The normalisation of Morris' Laplacian, per fluid particle (laminar viscosity, SPH_VISC_MORRIS).
+   Morris et al. 1997's term (see VISCOUS below) for particle i is sum_j K_ij (v_i - v_j),
+   K_ij = m_j (mu_i + mu_j)/(rho_i rho_j) F_ij r_ij^2/(r_ij^2 + eta^2), grad W_ij = F_ij x_ij
+   (F < 0). On a field with Hessian H (v_j - v_i = x_ji . grad v + 1/2 x_ji x_ji : H + ...), where
+   the neighbourhood's first moment vanishes, it gives nu T_i : H with the second-moment tensor
+       T_i = -sum_j V_j F_ij r_ij^2/(r_ij^2 + eta^2) x_ij (x) x_ij,   V_j = m_j / rho_j [-],
+   so nu m_i Lap v when T_i = m_i I (a square or cubic lattice, a flat wall continuing it). Its
+   continuous limit is exactly I (-(1/d) integral of r W'(r) dV = integral of W dV = 1, by parts),
+   but the discrete sum is not: m = 0.963 on a square lattice with Wendland C2 at h = 1.3 dx, at
+   any resolution (the quadrature error of a fixed h/dx), which made plane Poiseuille flow 4 % too
+   fast at 20 and at 40 particles across. The pass measures
+       m_i = tr T_i / d   [-],
+   over the particle's own fluid and wall neighbours (walls with the volume V_b / kappa_b they
+   have in the viscous term, free-slip walls included: m_i describes the particle arrangement, not
+   the boundary condition), and the viscous term uses the pair factor (1/m_i + 1/m_j)/2 (1/m_i
+   against walls). Then a quadratic field's Laplacian is reproduced wherever T_i is isotropic;
+   the factor is symmetric in i and j, so fluid-fluid forces stay pairwise antisymmetric and
+   momentum is conserved as before; m_i tends to 1 as h/dx grows (it is measured, not a lattice
+   constant), and the pass is a light neighbour loop (positions and densities, no velocities)
+   before each viscous pass. A particle with a truncated neighbourhood (free surface, splash) has m_i < 1, and
+   the correction also restores part of what its missing neighbours took: on the top row of a
+   square lattice (Wendland C2, h = 1.3 dx) m = 0.62, and the term gives 0.78 instead of 0.48 of
+   the Laplacian of u(y) across the surface, 1.22 instead of 0.75 along it. m_i -> 0 for a
+   particle with only far or no neighbours, so 1/m_i is bounded by 2: the largest eigenvalue of
+   the viscous operator grows at most twice (1/0.963 in a lattice's interior), within the margin
+   of def.cfl_viscous (a lattice is stable to dt = 0.29 h^2/nu for this form without the factor,
+   see sph_stable_dt, so to 0.145 with the bound; the default is 0.125). [writes w->priv.lapc, 1 / m_i] */
+static int sph__visc_norm_used(const sph_world* w) {
+    int q;
+    if (w->def.viscosity_form != SPH_VISC_MORRIS) return 0;
+    for (q = 0; q < w->nphase; ++q)
+        if (w->phases[q].viscosity > 0) return 1;
+    return 0;
+}
+
+/* The wall's density relative to rest as fluid particle i of relative density rhati sees it (the
+   boundary scheme's, see sph__interact_one). */
+SPH__INLINE sph_real sph__wall_kappa(const sph__ctx* c, size_t b, size_t i, sph_real rhati) {
+    if (c->bpq) return c->bpq[((size_t)b * (size_t)c->nphase + c->ph[i]) * 2 + 1];
+    return c->bp_mode == SPH_BP_EXTRAPOLATE ? c->brho[b] : rhati;
+}
+
+/* m_i for one particle; D a compile-time constant (the pass is specialised per dimension, as
+   sph__stage_interact's are: the loop over k unrolls and d[] stays in registers). */
+SPH__INLINE sph_real sph__visc_norm_one(const sph__ctx* c, size_t i, const int D) {
+    const sph_real* xi = c->x + i * (size_t)D;
+    const sph_real rhati = c->rho[i] * c->pc[c->ph[i]].inv_rho0;
+    const int per = c->periodic_any, form = c->k.form;
+    sph_real S = 0; /* sum_j V_j (-F_ij) r^4/(r^2 + eta^2) = d m_i, without the factor norm_g */
+    size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
+    int k;
+    for (kk = k0; kk < k1; ++kk) {
+        const size_t j = c->ff->idx[kk];
+        const sph_real mj = c->m ? c->m[j] : c->m0;
+        sph_real d[3] = {0, 0, 0}, r2 = 0;
+        sph__delta_vec_p(c, per, xi, c->x + j * (size_t)D, d, D);
+        SPH__FOR_K(D, r2 += d[k] * d[k]);
+        S -= mj / c->rho[j] * sph__kf(form, sph__sqrt(r2) * c->k.inv_h) * r2 * r2 / (r2 + c->eta2);
+    }
+    if (c->has_b) {
+        k0 = c->fb->begin[i];
+        k1 = k0 + c->fb->count[i];
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t b = c->fb->idx[kk];
+            sph_real d[3] = {0, 0, 0}, r2 = 0;
+            sph__delta_vec_p(c, per, xi, c->bx + b * (size_t)D, d, D);
+            SPH__FOR_K(D, r2 += d[k] * d[k]);
+            S -= c->bvol[b] / sph__wall_kappa(c, b, i, rhati) *
+                 sph__kf(form, sph__sqrt(r2) * c->k.inv_h) * r2 * r2 / (r2 + c->eta2);
+        }
+    }
+    return S * c->k.norm_g / (sph_real)D;
+}
+
+static void sph__stage_visc_norm(sph_world* w, const sph__ctx* c) {
+    const int D = c->dim;
+    sph__idx i;
+    SPH_ASSERT(c->lapc && w->priv.lapc_cap >= w->n);
+    SPH__OMP_FOR(w->n)
+    for (i = 0; i < (sph__idx)w->n; ++i) {
+        const sph_real m = D == 2 ? sph__visc_norm_one(c, (size_t)i, 2)
+                         : D == 3 ? sph__visc_norm_one(c, (size_t)i, 3)
+                                  : sph__visc_norm_one(c, (size_t)i, 1);
+        w->priv.lapc[i] = m > SPH__R(0.5) ? 1 / m : 2;
+    }
+}
+
 /* What a pass of the neighbour loop computes: pressure acceleration, viscous acceleration,
    density rate; SET overwrites the acceleration output instead of adding to it; ENERGY (with
    PRESSURE, VISCOUS and RATE) computes the internal energy rate instead of an acceleration. */
@@ -4002,7 +4125,8 @@ enum { SPH__PRESSURE = 1, SPH__VISCOUS = 2, SPH__RATE = 4, SPH__SET = 8, SPH__CA
           (extrapolated; mirrored p_b = p_i, rho_b = rho_i; or p_b = 0). [m/s^2]
    VISCOUS: laminar viscosity (Morris et al. 1997: sum_j m_j (mu_i + mu_j)/(rho_i rho_j)
           x_ij.grad W_ij/(r^2+eta^2) v_ij, which needs only the second moment of grad W to give
-          nu Lap v, 0.96 of it on a lattice with Wendland C2 at h = 1.3 dx; or Monaghan 2005 /
+          nu Lap v, 0.96 of it on a lattice with Wendland C2 at h = 1.3 dx, so each pair is
+          multiplied by (1/m_i + 1/m_j)/2, m the measured moment (sph__stage_visc_norm); or Monaghan 2005 /
           Enhanced PCISPH 2018 eq. 2.5, 2(d+2) sum_j m_j nu_bar/rho_bar v_ij.x_ij/(r^2+eta^2) grad
           W, which conserves angular momentum but needs the fourth moment: 0.80 of nu Lap v on the
           same lattice) and Monaghan 1992 artificial viscosity Pi_ij = (-alpha c_bar mu_ij +
@@ -4095,8 +4219,9 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
         if (flags & SPH__VISCOUS) {
             if (laminar) {
                 const sph_real lv = c->visc_k * mj * (P->mu + Pj->mu) * inv_rhoi / rhoj / (r2 + c->eta2);
-                if (c->morris) { /* along v_ij: x_ij . grad W = fw r^2 */
-                    lm = lv * fw * r2;
+                if (c->morris) { /* along v_ij: x_ij . grad W = fw r^2; normalised by
+                                    (1/m_i + 1/m_j)/2 (sph__stage_visc_norm) */
+                    lm = lv * fw * r2 * SPH__R(0.5) * (c->lapc[i] + c->lapc[j]);
                     SPH__FOR_K(D, ai[k] += lm * (ui[k] - uj[k]));
                 } else {
                     s += lv * ud;
@@ -4157,7 +4282,7 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
                 if (laminar) {
                     const sph_real lv = c->visc_k * psi * 2 * P->mu * inv_rhoi / rhob / (r2 + c->eta2);
                     if (c->morris) {
-                        lm = lv * fw * r2;
+                        lm = lv * fw * r2 * c->lapc[i];
                         SPH__FOR_K(D, ai[k] += lm * (ui[k] - vw[k]));
                     } else {
                         s += lv * ug;
@@ -4200,6 +4325,8 @@ static void sph__stage_interact(sph_world* w, const sph__ctx* c, int flags, sph_
                      c->pgrad == SPH_PGRAD_SYMMETRIC && !c->laminar && c->k.form == SPH__KF_WC2 &&
                      (c->dim == 2 || c->dim == 3);
     sph__idx blk;
+    /* the Laplacian's normalisation at these positions (the energy pass reuses its force pass's) */
+    if ((flags & SPH__VISCOUS) && !(flags & SPH__ENERGY) && c->lapc) sph__stage_visc_norm(w, c);
     SPH__OMP_FOR(w->n) /* over blocks of SPH__BLOCK particles */
     for (blk = 0; blk < (sph__idx)nblk; ++blk) {
         const size_t i0 = (size_t)blk * SPH__BLOCK;
@@ -4779,6 +4906,7 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
     s = sph__reserve_blocks(w);
     if (s == SPH_OK && sph__phase_walls_for(w, (int)solver))
         s = sph__scratch(w, &w->priv.bpq, w->nb * (size_t)w->nphase * 2);
+    if (s == SPH_OK && sph__visc_norm_used(w)) s = sph__scratch(w, &w->priv.lapc, w->capacity);
     if (s != SPH_OK) return s;
     s = sph__resolve_sound_speed(w);
     if (s != SPH_OK) {

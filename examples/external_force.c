@@ -15,9 +15,9 @@
    Run:   mkdir -p out && ./build/external_force [output dir = out]
    Checks (exit status 1 if one fails): at t = 0.8 s (8 viscous decay times) the centre-line
    speed is the analytic g_x H^2 / (8 nu) within 3 %, and the profile has the parabola's shape
-   within 2 % RMS. With the default h = 1.3 dx the centre speed comes out about 4 % high: that
-   is the lattice normalisation of Morris' Laplacian (0.963, see sph.h's KERNELS notes); this
-   example uses h = 2 dx, where it is about 1.5 % high. */
+   within 2 % RMS. The laminar viscosity divides out the lattice normalisation of Morris'
+   Laplacian (0.963 at the default h = 1.3 dx; see sph.h's VISCOSITY notes); this example uses
+   h = 2 dx, where the centre speed comes out 0.06 % low (1.5 % high before the normalisation). */
 #define SPH_IMPLEMENTATION
 #include "sph.h"
 #include "examples/draw.h"

@@ -45,6 +45,8 @@ extern const th_test tests_validation[]; /* methods failing are detected (issue 
 extern const th_test tests_scenes[]; /* user scenes through sph_advance with the defaults */
 extern const th_test tests_scenes_long[];
 extern const th_test tests_hostile[]; /* hostile input (issue 19) */
+extern const th_test tests_viscous[]; /* viscous accuracy and dissipation (issue 18) */
+extern const th_test tests_viscous_long[];
 
 void th_fail(const char* file, int line, const char* fmt, ...);
 void th_note(const char* fmt, ...);

@@ -1,0 +1,330 @@
+/* tests/test_viscous.c - viscous accuracy through sph_advance with the defaults (issue 18):
+   - plane Poiseuille flow between no-slip walls, periodic in x, driven by a body force g: the
+     steady profile u(y) = g y (H - y) / (2 nu) (Morris, Fox & Zhu 1997 validate their viscous term on it), centre speed
+     and RMS over the profile at 20 particles across (and 40 in the long set: the error must not
+     grow with resolution), WCSPH, IISPH and DFSPH;
+   - a Taylor-Green vortex cell filling a closed free-slip box: its kinetic energy decays as
+     exp(-4 pi^2 nu t / L^2) (see run_box_decay); the measured decay rate per solver, with the
+     default artificial viscosity and without. (The periodic Taylor-Green box of
+     scene_taylor_green, wavelength L, decays as exp(-16 pi^2 nu t / L^2); with the standard
+     options and c0 = 10 U, IISPH and DFSPH blow up in it by t = 0.1 s and WCSPH and PCISPH
+     decay 4.1 and 3.6 times too fast at 40 x 40, so it is the second-order scheme's test,
+     tests/test_soc.c.) */
+#include "harness.h"
+#include "../sph.h"
+#include "../examples/scenes.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#ifdef _OPENMP
+#include <omp.h>
+#include "state_hash.h"
+#endif
+
+/* ---- plane Poiseuille flow ------------------------------------------------------------------ */
+
+typedef struct poiseuille_result {
+    sph_status status;
+    double centre;  /* (u - u_exact)/u_max, mean of the two rows beside y = H/2 [-]            */
+    double rms;     /* RMS over the rows of (u_row - u_exact(y_row)) / u_max [-]                */
+    double v_max;   /* largest |v_y| / u_max [-]                                                */
+    double ms_step; /* wall-clock milliseconds per sub-step                                     */
+    unsigned long long steps;
+} poiseuille_result;
+
+/* Fluid of rest density 1 between walls at y = 0 and y = H = 1 (the walls' particles start half
+   a spacing outside, so the no-slip plane is at 0 and H), N particles across, 0.5 m long and
+   periodic in x, nu = 0.5 m^2/s, g = 1 m/s^2 along x: u_max = g H^2 / (8 nu) = 0.25 m/s, Re =
+   u_max H / nu = 0.5. Sound speed 10 u_max. The slowest mode of the start-up decays as
+   exp(-pi^2 nu t / H^2) (the first term of the series solution), 0.2 s: at t = 2.5 s it is e^-12 of its start,
+   far below 1e-3, so the profile is the steady one. */
+static poiseuille_result run_poiseuille(sph_solver solver, int N, double t_end) {
+    const double H = 1.0, L = 0.5, nu = 0.5, g = 1.0, umax = g * H * H / (8 * nu);
+    sph_world_def def = sph_world_def_default(2);
+    sph_world w;
+    sph_phase fluid;
+    sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)L, (sph_real)H};
+    poiseuille_result r;
+    double sum[80], cnt[80], t0;
+    size_t i;
+    int b;
+    memset(&r, 0, sizeof r);
+    def.spacing = (sph_real)(H / N);
+    def.solver = solver;
+    def.gravity[0] = (sph_real)g;
+    def.gravity[1] = 0;
+    def.wall = SPH_WALL_NO_SLIP;
+    def.periodic[0] = 1;
+    def.domain_lo[0] = 0;
+    def.domain_hi[0] = (sph_real)L;
+    memset(&fluid, 0, sizeof fluid);
+    fluid.rest_density = 1;
+    fluid.viscosity = (sph_real)nu;
+    fluid.sound_speed = (sph_real)(10 * umax);
+    if (sph_world_init(&w, &def) != SPH_OK || sph_world_add_phase(&w, &fluid) != 0 ||
+        sph_fill_box(&w, 0, lo, hi) != SPH_OK ||
+        sph_add_wall_box(&w, lo, hi, 0, SPH_FACE_XMIN | SPH_FACE_XMAX) != SPH_OK) {
+        th_fail(__FILE__, __LINE__, "channel setup: %s", w.error);
+        r.status = w.status;
+        return r;
+    }
+    t0 = (double)clock() / CLOCKS_PER_SEC;
+    r.status = sph_advance(&w, (sph_real)t_end);
+    r.steps = (unsigned long long)w.steps;
+    r.ms_step = 1e3 * ((double)clock() / CLOCKS_PER_SEC - t0) / (double)(w.steps ? w.steps : 1);
+    for (b = 0; b < N; ++b) sum[b] = cnt[b] = 0;
+    for (i = 0; i < w.n; ++i) {
+        b = (int)floor((double)w.x[2 * i + 1] / H * N);
+        if (b >= 0 && b < N) { sum[b] += (double)w.v[2 * i]; cnt[b] += 1; }
+        r.v_max = fmax(r.v_max, fabs((double)w.v[2 * i + 1]) / umax);
+    }
+    for (b = 0; b < N; ++b) {
+        const double y = (b + 0.5) * H / N, ue = g * y * (H - y) / (2 * nu);
+        const double e = cnt[b] > 0 ? (sum[b] / cnt[b] - ue) / umax : 1;
+        r.rms += e * e;
+        if (b == N / 2 - 1 || b == N / 2) r.centre += 0.5 * e;
+    }
+    r.rms = sqrt(r.rms / N);
+    sph_world_free(&w);
+    return r;
+}
+
+static const char* solver_label(sph_solver s) {
+    return s == SPH_SOLVER_WCSPH ? "WCSPH" : s == SPH_SOLVER_IISPH ? "IISPH"
+           : s == SPH_SOLVER_DFSPH ? "DFSPH" : s == SPH_SOLVER_PCISPH ? "PCISPH" : "other";
+}
+
+static void check_poiseuille(sph_solver solver, int N) {
+    const poiseuille_result r = run_poiseuille(solver, N, 2.5);
+    CHECK_MSG(r.status == SPH_OK, "%s Poiseuille: status %d", solver_label(solver), (int)r.status);
+    TH_NOTE("%s Poiseuille, %d across, t = 2.5 s: centre error %+.4f u_max, RMS %.4f u_max, "
+            "|v_y| <= %.1e u_max, %llu steps, %.3f ms per step", solver_label(solver), N,
+            r.centre, r.rms, r.v_max, r.steps, r.ms_step);
+    CHECK_LT(fabs(r.centre), 0.01);
+    CHECK_LT(r.rms, 0.01);
+    CHECK_LT(r.v_max, 0.01);
+}
+
+static void test_poiseuille_wcsph_20(void) { check_poiseuille(SPH_SOLVER_WCSPH, 20); }
+static void test_poiseuille_iisph_20(void) { check_poiseuille(SPH_SOLVER_IISPH, 20); }
+static void test_poiseuille_dfsph_20(void) { check_poiseuille(SPH_SOLVER_DFSPH, 20); }
+static void test_poiseuille_wcsph_40(void) { check_poiseuille(SPH_SOLVER_WCSPH, 40); }
+
+/* ---- a decaying vortex in a closed box ----------------------------------------------------- */
+
+typedef struct decay_result {
+    sph_status status;
+    double ratio; /* measured decay rate of the kinetic energy / exact rate 4 pi^2 nu / L^2 [-] */
+    double ke;    /* KE(t_end) / KE(0) [-]                                                     */
+} decay_result;
+
+/* A unit box of water (rest density 1000, nu = 0.01 m^2/s, no gravity) completely filled, walls
+   with the defaults (free slip), u = U sin(pi x) cos(pi y), v = -U cos(pi x) sin(pi y), U = 1 m/s:
+   a Taylor-Green cell of wavelength 2 L. The walls carry no normal velocity and no shear stress
+   (dv/dx = 0 at x = 0, L), so the free-slip box holds the periodic solution exactly: nu Lap u =
+   -2 pi^2 nu / L^2 u, and the kinetic energy decays as exp(-4 pi^2 nu t / L^2) (0.395 /s; the
+   nonlinear term is a gradient the pressure balances). The scene of tests/test_scenes.c's box.
+   Through sph_advance with the defaults; the rate is the least-squares slope of ln KE over
+   samples every 0.05 s. alpha: def.alpha (artificial viscosity; default 0.02). */
+static decay_result run_box_decay(sph_solver solver, int N, double alpha, double t_end) {
+    const double nu = 0.01, L = 1, exact = 4 * SCENE_TG_PI * SCENE_TG_PI * nu / (L * L);
+    sph_world_def def = sph_world_def_default(2);
+    sph_world w;
+    sph_phase water;
+    sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)L, (sph_real)L};
+    decay_result r;
+    double st = 0, sy = 0, stt = 0, sty = 0, ns = 0, ke0 = 0, ke = 0;
+    int f, frames = (int)(t_end / 0.05 + 0.5);
+    size_t i;
+    memset(&r, 0, sizeof r);
+    memset(&water, 0, sizeof water);
+    water.rest_density = 1000;
+    water.viscosity = (sph_real)nu;
+    if (solver == SPH_SOLVER_PCISPH) sph_world_def_pcisph(&def, 0);
+    def.solver = solver;
+    def.alpha = (sph_real)alpha;
+    def.spacing = (sph_real)(L / N);
+    def.gravity[1] = 0;
+    if (sph_world_init(&w, &def) != SPH_OK || sph_world_add_phase(&w, &water) != 0 ||
+        sph_fill_box(&w, 0, lo, hi) != SPH_OK || sph_add_wall_box(&w, lo, hi, 0, 0) != SPH_OK) {
+        th_fail(__FILE__, __LINE__, "box setup: %s", w.error);
+        r.status = w.status;
+        return r;
+    }
+    for (i = 0; i < w.n; ++i) {
+        const double x = (double)w.x[2 * i] / L, y = (double)w.x[2 * i + 1] / L;
+        w.v[2 * i] = (sph_real)(sin(SCENE_TG_PI * x) * cos(SCENE_TG_PI * y));
+        w.v[2 * i + 1] = (sph_real)(-cos(SCENE_TG_PI * x) * sin(SCENE_TG_PI * y));
+    }
+    for (i = 0; i < 2 * w.n; ++i) ke0 += 0.5 * (double)w.v[i] * (double)w.v[i];
+    st = 0; sy = log(ke0); stt = 0; sty = 0; ns = 1;
+    for (f = 1; f <= frames && r.status == SPH_OK; ++f) {
+        r.status = sph_advance(&w, (sph_real)0.05);
+        ke = 0;
+        for (i = 0; i < 2 * w.n; ++i) ke += 0.5 * (double)w.v[i] * (double)w.v[i];
+        st += w.time; sy += log(ke); stt += w.time * w.time; sty += w.time * log(ke); ns += 1;
+    }
+    if (r.status != SPH_OK) th_fail(__FILE__, __LINE__, "box decay: %s", w.error);
+    r.ratio = -(ns * sty - st * sy) / (ns * stt - st * st) / exact;
+    r.ke = ke / ke0;
+    sph_world_free(&w);
+    return r;
+}
+
+/* Per solver with the defaults, over 0.5 s at 25 x 25: the kinetic energy decays at least at the
+   physical rate (ratio >= 0.9: a viscous term that lost part of its Laplacian, or walls that
+   added energy, would show), and the default artificial viscosity (alpha = 0.02) changes the
+   rate by at most 0.15 of the physical one (it is not what makes the decay too fast). The
+   upper bounds are the known excess (measured 4.2 WCSPH, 2.9 IISPH, 3.0 DFSPH and PCISPH): the
+   lattice breaks up along the stretching directions after t = 0.2 s and the disordered
+   particles dissipate; they hold it from growing unnoticed, they do not call it right. */
+static void test_box_decay(void) {
+    static const sph_solver solvers[] = {SPH_SOLVER_WCSPH, SPH_SOLVER_IISPH, SPH_SOLVER_DFSPH,
+                                         SPH_SOLVER_PCISPH};
+    static const double known_excess[] = {4.6, 3.3, 3.4, 3.4};
+    int s;
+    for (s = 0; s < 4; ++s) {
+        const decay_result on = run_box_decay(solvers[s], 25, 0.02, 0.5);
+        const decay_result off = run_box_decay(solvers[s], 25, 0, 0.5);
+        TH_NOTE("%s vortex box 25^2, t <= 0.5 s: decay rate / exact %.3f (alpha 0.02, KE %.3f), "
+                "%.3f (alpha 0, KE %.3f); exact KE %.3f", solver_label(solvers[s]), on.ratio,
+                on.ke, off.ratio, off.ke, exp(-4 * SCENE_TG_PI * SCENE_TG_PI * 0.01 * 0.5));
+        CHECK_EQ_INT(on.status, SPH_OK);
+        CHECK_EQ_INT(off.status, SPH_OK);
+        CHECK_LE(0.9, on.ratio);
+        CHECK_LE(0.9, off.ratio);
+        CHECK_LT(fabs(on.ratio - off.ratio), 0.15);
+        CHECK_LT(on.ratio, known_excess[s]);
+    }
+}
+
+/* ---- conservation and determinism of the normalised term ------------------------------------ */
+
+/* A periodic box of viscous fluid (nu = 0.05 m^2/s, no walls, no gravity) on a lattice shaken by
+   up to 0.025 dx, so every particle's moment m_i differs, with a sheared velocity field: the pair
+   factor (1/m_i + 1/m_j)/2 is symmetric, so the forces are pairwise antisymmetric and the total
+   momentum stays at its start to round-off (relative to sum m |v|) over 20 steps, per solver
+   (1/m_i alone in place of the pair factor leaves 3e-7 ... 7e-6 of it). */
+static void test_momentum_conserved(void) {
+    static const sph_solver solvers[] = {SPH_SOLVER_WCSPH, SPH_SOLVER_IISPH, SPH_SOLVER_DFSPH};
+    int s;
+    for (s = 0; s < 3; ++s) {
+        sph_world_def def = sph_world_def_default(2);
+        sph_world w;
+        sph_phase fluid;
+        sph_real lo[2] = {0, 0}, hi[2] = {1, 1};
+        double p0[2] = {0, 0}, p1[2] = {0, 0}, scale = 0, lcg = 1;
+        size_t i;
+        int k;
+        memset(&fluid, 0, sizeof fluid);
+        fluid.rest_density = 1;
+        fluid.viscosity = (sph_real)0.05;
+        fluid.sound_speed = 10;
+        def.solver = solvers[s];
+        def.spacing = (sph_real)(1.0 / 30);
+        def.gravity[1] = 0;
+        for (k = 0; k < 2; ++k) {
+            def.periodic[k] = 1;
+            def.domain_lo[k] = 0;
+            def.domain_hi[k] = 1;
+        }
+        CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
+        CHECK(sph_world_add_phase(&w, &fluid) == 0);
+        CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
+        for (i = 0; i < w.n; ++i) {
+            for (k = 0; k < 2; ++k) { /* a linear congruential sequence: the same in every build */
+                lcg = fmod(lcg * 16807.0, 2147483647.0);
+                w.x[2 * i + (size_t)k] += (sph_real)(0.05 * (lcg / 2147483647.0 - 0.5) * (double)w.dx);
+            }
+            w.v[2 * i] = (sph_real)(0.3 + sin(2 * SCENE_TG_PI * (double)w.x[2 * i + 1]));
+            w.v[2 * i + 1] = (sph_real)(0.5 * cos(2 * SCENE_TG_PI * (double)w.x[2 * i]));
+        }
+        for (i = 0; i < w.n; ++i)
+            for (k = 0; k < 2; ++k) p0[k] += (double)w.mass * (double)w.v[2 * i + (size_t)k];
+        for (k = 0; k < 20; ++k) {
+            sph_status st = th_step(&w, (sph_real)2e-4);
+            CHECK_MSG(st == SPH_OK, "%s: %s", solver_label(solvers[s]), w.error);
+            if (st != SPH_OK) break;
+        }
+        for (i = 0; i < w.n; ++i)
+            for (k = 0; k < 2; ++k) {
+                p1[k] += (double)w.mass * (double)w.v[2 * i + (size_t)k];
+                scale += (double)w.mass * fabs((double)w.v[2 * i + (size_t)k]);
+            }
+        TH_NOTE("%s periodic shaken box, nu = 0.05, 20 steps: |P - P0| / sum m|v| = %.2g, %.2g",
+                solver_label(solvers[s]), fabs(p1[0] - p0[0]) / scale, fabs(p1[1] - p0[1]) / scale);
+        CHECK_LT(fabs(p1[0] - p0[0]) / scale, 100 * TH_EPS);
+        CHECK_LT(fabs(p1[1] - p0[1]) / scale, 100 * TH_EPS);
+        sph_world_free(&w);
+    }
+}
+
+/* The normalisation pass is a gather like every other: 1 and 2 threads give bitwise the same
+   state (the no-slip vortex box at 60 x 60, above the 2048 particles of the serial cutoff, 10
+   steps, WCSPH and IISPH). */
+#ifdef _OPENMP
+static uint64_t viscous_box_hash(sph_solver solver, int threads) {
+    sph_world_def def = sph_world_def_default(2);
+    sph_world w;
+    sph_phase water;
+    sph_real lo[2] = {0, 0}, hi[2] = {1, 1};
+    uint64_t hash;
+    size_t i;
+    int k;
+    omp_set_num_threads(threads);
+    memset(&water, 0, sizeof water);
+    water.rest_density = 1000;
+    water.viscosity = (sph_real)0.01;
+    water.sound_speed = 10;
+    def.solver = solver;
+    def.spacing = (sph_real)(1.0 / 60);
+    def.gravity[1] = 0;
+    def.wall = SPH_WALL_NO_SLIP;
+    CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
+    CHECK(sph_world_add_phase(&w, &water) == 0);
+    CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
+    CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 0, 0), SPH_OK);
+    for (i = 0; i < w.n; ++i) {
+        const double x = (double)w.x[2 * i], y = (double)w.x[2 * i + 1];
+        w.v[2 * i] = (sph_real)(sin(SCENE_TG_PI * x) * cos(SCENE_TG_PI * y));
+        w.v[2 * i + 1] = (sph_real)(-cos(SCENE_TG_PI * x) * sin(SCENE_TG_PI * y));
+    }
+    for (k = 0; k < 10; ++k) CHECK_EQ_INT(th_step(&w, sph_stable_dt(&w, solver)), SPH_OK);
+    CHECK(w.n > 2048);
+    hash = th_state_hash(&w);
+    sph_world_free(&w);
+    return hash;
+}
+
+#endif
+
+static void test_threads_bitwise(void) {
+#ifdef _OPENMP
+    static const sph_solver solvers[] = {SPH_SOLVER_WCSPH, SPH_SOLVER_IISPH};
+    int s;
+    for (s = 0; s < 2; ++s) {
+        const uint64_t h1 = viscous_box_hash(solvers[s], 1), h2 = viscous_box_hash(solvers[s], 2);
+        CHECK_MSG(h1 == h2, "%s: 1 and 2 threads differ", solver_label(solvers[s]));
+    }
+    omp_set_num_threads(omp_get_num_procs());
+#else
+    TH_SKIP("built without OpenMP");
+#endif
+}
+
+const th_test tests_viscous[] = {
+    {"viscous/poiseuille_wcsph_20", test_poiseuille_wcsph_20},
+    {"viscous/poiseuille_iisph_20", test_poiseuille_iisph_20},
+    {"viscous/poiseuille_dfsph_20", test_poiseuille_dfsph_20},
+    {"viscous/box_decay", test_box_decay},
+    {"viscous/momentum_conserved", test_momentum_conserved},
+    {"viscous/threads_bitwise", test_threads_bitwise},
+    {0, 0},
+};
+
+const th_test tests_viscous_long[] = {
+    {"viscous-long/poiseuille_wcsph_40", test_poiseuille_wcsph_40},
+    {0, 0},
+};
