@@ -548,6 +548,16 @@ static int suite_iisph_sweep(const opts* o) {
     return 1;
 }
 
+/* The host's 1-minute load average (Linux; 0 elsewhere): other work on a shared machine. */
+static double load_average(void) {
+    double l = 0;
+    FILE* f = fopen("/proc/loadavg", "r");
+    if (!f) return 0;
+    if (fscanf(f, "%lf", &l) != 1) l = 0;
+    fclose(f);
+    return l;
+}
+
 /* Time to solution: each scene run to --t-end through sph_advance with the library's defaults
    (no max_dt, no tuned tolerance: what a user gets), one frame (1/50 s) per call. A run stops
    at its first error, reported with the time it reached. */
@@ -570,7 +580,7 @@ static int suite_tts(const opts* o) {
     FILE* f = csv_open(o, "tts.csv",
                        "scene,solver,precision,threads,fluid,walls,t_end,time_reached,status,"
                        "wall_s,s_per_sim_s,frames,substeps,retries,dt_mean,dt_min,iters_mean,"
-                       "err_mean,comp_mean,comp_max,outside_max,capped,error");
+                       "err_mean,comp_mean,comp_max,outside_max,outside_depth_dx,capped,load1,error");
     if (!f) return 0;
     if (o->threads_set)
         threads[nthreads++] = o->threads;
@@ -590,10 +600,11 @@ static int suite_tts(const opts* o) {
         if (scenes >> sc & 1) printf("  %-7s %s\n", tts_scene_names[sc], tts_scene_what[sc]);
     printf("  s/sim-s: wall-clock seconds per simulated second (inside sph_advance); comp: mean "
            "over frames of the mean max(rho/rho0-1, 0) and its max; |err|: mean |rho/rho0-1|; "
-           "out: most fluid particles outside the container at a frame end\n");
-    printf("  %-7s %-10s %-6s %3s %7s %6s %9s %8s %8s %7s %8s %7s %9s %8s %5s  %s\n", "scene",
-           "solver", "prec", "thr", "fluid", "walls", "s/sim-s", "t [s]", "substeps", "retries",
-           "iters", "|err|%", "comp %", "cmax %", "out", "status");
+           "out: most fluid particles outside the container at a frame end, depth: the farthest "
+           "one [dx]; load: 1-minute load average after the run (the host is shared)\n");
+    printf("  %-7s %-10s %-6s %3s %7s %6s %9s %8s %8s %7s %6s %7s %7s %7s %5s %6s %5s  %s\n",
+           "scene", "solver", "prec", "thr", "fluid", "walls", "s/sim-s", "t [s]", "substeps",
+           "retries", "iters", "|err|%", "comp %", "cmax %", "out", "depth", "load", "status");
     fflush(stdout);
     for (sc = 0; sc < TTS_NSCENE; ++sc) {
         if (!(scenes >> sc & 1)) continue;
@@ -613,12 +624,12 @@ static int suite_tts(const opts* o) {
                         bench_tts_f(sc, sv, o->quick, t_end, o->max_wall, o->quick ? 0 : 60, r);
                     ++ncell;
                     rt = r->time > 0 ? r->wall_s / r->time : NAN;
-                    printf("  %-7s %-10s %-6s %3d %7.0f %6.0f %9.3g %8.3f %8.0f %7.0f %8.1f %7.3f "
-                           "%9.3f %8.2f %5.0f  %s\n",
+                    printf("  %-7s %-10s %-6s %3d %7.0f %6.0f %9.3g %8.3f %8.0f %7.0f %6.1f %7.3f "
+                           "%7.3f %7.2f %5.0f %6.2f %5.1f  %s\n",
                            tts_scene_names[sc], tts_solver_names[sv], pr ? "float" : "double",
                            threads[ti], r->n, r->nb, rt, r->time, r->substeps, r->retries,
                            r->its_mean, 100 * r->err_mean, 100 * r->comp_mean, 100 * r->comp_max,
-                           r->outside_max,
+                           r->outside_max, r->outside_depth, load_average(),
                            r->status > 0   ? sph_status_string((sph_status)r->status)
                            : r->status < 0 ? "scene not built"
                            : r->capped     ? "stopped at --max-wall"
@@ -627,7 +638,7 @@ static int suite_tts(const opts* o) {
                     fflush(stdout);
                     fprintf(f,
                             "%s,%s,%s,%d,%.0f,%.0f,%.4f,%.6f,%s,%.3f,%.6g,%d,%.0f,%.0f,%.6g,%.6g,"
-                            "%.2f,%.6g,%.6g,%.6g,%.0f,%d,\"",
+                            "%.2f,%.6g,%.6g,%.6g,%.0f,%.3f,%d,%.2f,\"",
                             tts_scene_names[sc], tts_solver_names[sv], pr ? "float" : "double",
                             threads[ti], r->n, r->nb, t_end, r->time,
                             r->status > 0   ? sph_status_string((sph_status)r->status)
@@ -636,7 +647,7 @@ static int suite_tts(const opts* o) {
                             r->wall_s, rt, r->frames, r->substeps, r->retries,
                             r->substeps > r->retries ? r->time / (r->substeps - r->retries) : 0,
                             r->dt_min, r->its_mean, r->err_mean, r->comp_mean, r->comp_max,
-                            r->outside_max, r->capped);
+                            r->outside_max, r->outside_depth, r->capped, load_average());
                     for (c = r->error; *c; ++c) /* the message, CSV-quoted */
                         if (*c == '"')
                             fputs("\"\"", f);

@@ -493,9 +493,16 @@ BENCH_FN int BX(tts)(int scene, int solver, int quick, double t_end, double max_
         }
         for (i = 0; i < w.n; ++i) {
             const double e = (double)w.rho[i] / rho0 - 1;
+            int k;
             e_sum += fabs(e);
             c_sum += e > 0 ? e : 0;
             if (e > c_max) c_max = e;
+            for (k = 0; k < w.dim; ++k) { /* depth outside the container (w.def.domain) */
+                const double x = (double)w.x[i * (size_t)w.dim + (size_t)k];
+                const double d = fmax((double)w.def.domain_lo[k] - x,
+                                      x - (double)w.def.domain_hi[k]) / (double)w.dx;
+                if (d > r->outside_depth) r->outside_depth = d;
+            }
         }
         sum_err += w.n ? e_sum / (double)w.n : 0;
         sum_comp += w.n ? c_sum / (double)w.n : 0;

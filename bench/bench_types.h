@@ -76,6 +76,7 @@ typedef struct tts_result {
     double comp_max;       /* max over frame ends and particles of rho/rho0 - 1                 */
     double its_mean;       /* mean over frame ends of the last sub-step's solver iterations     */
     double outside_max;    /* max over frame ends of the fluid particles outside the container  */
+    double outside_depth;  /* the farthest any was outside it [particle spacings]               */
     int frames;            /* frames completed                                                  */
     int status;            /* sph_status of the call that failed (0: none), -1: scene not built */
     int capped;            /* stopped by --max-wall                                             */
