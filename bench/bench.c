@@ -20,15 +20,17 @@
                  second, time reached (a run stops at its first error and reports it), sub-steps,
                  retries, density error, particles outside the container. Scenes: 2d (examples/
                  dambreak.c's), 3d-6k and 3d-59k (SPlisHSPlasH's DamBreakModel at dx 0.05 and
-                 0.025 m); default 2d and 3d-6k, --quick: 2d at 10 particles per a to 0.1 s,
-                 wcsph and dfsph. Select cells with --scene, --solver (comma lists or all),
-                 --precision, --threads; --max-wall S stops a run after S wall-clock seconds
+                 0.025 m); default 2d only (make bench-tts runs all), --quick: 2d at 10
+                 particles per a to 0.1 s, wcsph and dfsph. Select cells with --scene, --solver
+                 (comma lists or all), --precision, --threads; --max-wall S stops a run after S
+                 wall-clock seconds (it reports the time it reached)
    Options: --quick (small sizes, < 1 minute), --out DIR (CSV and SVG; default bench/results),
             --n N, --scene S, --solver S, --threads T, --repeats R, --steps K, --t-end T (tts:
             simulated seconds, default 1), --max-wall S, --precision double|float|all
    Every timing is the median over the repeats of a wall-clock time per step; runs that are
    compared (ours against the baseline, double against float) alternate inside one repeat loop,
-   so a slow minute on a shared machine hits both. */
+   so a slow minute on a shared machine hits both. tts is the exception: one run per cell (each
+   is thousands of steps), printed with the host's load average. */
 #define SPH_IMPLEMENTATION
 #include "sph.h"
 #include "examples/scenes.h"
@@ -563,9 +565,7 @@ static double load_average(void) {
    at its first error, reported with the time it reached. */
 static int suite_tts(const opts* o) {
     static const int quick_solvers = (1 << TTS_WCSPH) | (1 << TTS_DFSPH);
-    const unsigned scenes = o->tts_scenes ? o->tts_scenes
-                                          : o->quick ? 1u << TTS_DAM2D
-                                                     : (1u << TTS_DAM2D) | (1u << TTS_DAM3D_COARSE);
+    const unsigned scenes = o->tts_scenes ? o->tts_scenes : 1u << TTS_DAM2D; /* 3D: --scene */
     const unsigned solvers = o->tts_solvers ? o->tts_solvers
                                             : o->quick ? (unsigned)quick_solvers
                                                        : (1u << TTS_NSOLVER) - 1;
