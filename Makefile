@@ -65,8 +65,9 @@ validate: $(B)/tests
 
 BENCH_N ?= 80
 # make bench: every suite of the benchmark driver (sph.h against its baseline, scaling, search,
-# float, memory, cost growth, optional physics) and the Taylor-Green convergence study, CSV and
-# SVG into bench/results/ (about 15 minutes on 2 cores). make bench-quick: the same suites at
+# float, memory, cost growth, optional physics, time to solution on the 2D dam break in double
+# on 2 threads) and the Taylor-Green convergence study, CSV and SVG into bench/results/ (about
+# 15 minutes on 2 cores; the 3D time-to-solution runs are behind make bench-tts). make bench-quick: the same suites at
 # small sizes into out/bench-quick/ (under a minute; CI runs it so the log shows a regression).
 bench: $(B)/bench $(B)/convergence
 	mkdir -p bench/results

@@ -21,7 +21,8 @@
                  retries, density error, particles outside the container. Scenes: 2d (examples/
                  dambreak.c's), 3d-6k and 3d-59k (SPlisHSPlasH's DamBreakModel at dx 0.05 and
                  0.025 m); default 2d only (make bench-tts runs all), --quick: 2d at 10
-                 particles per a to 0.1 s, wcsph and dfsph. Select cells with --scene, --solver
+                 particles per a to 0.1 s, wcsph and dfsph; among the default suites of a full
+                 run (make bench) double and 2 threads only. Select cells with --scene, --solver
                  (comma lists or all), --precision, --threads; --max-wall S stops a run after S
                  wall-clock seconds (it reports the time it reached)
    Options: --quick (small sizes, < 1 minute), --out DIR (CSV and SVG; default bench/results),
@@ -50,6 +51,7 @@ int bench_tts_f(int scene, int solver, int quick, double t_end, double max_wall,
 
 typedef struct opts {
     int quick, repeats, steps, threads, threads_set, scene, solver;
+    int suites_default; /* no suite named: tts runs a smaller default set (see suite_tts) */
     unsigned tts_scenes, tts_solvers, precisions; /* bit masks (tts); 0 = the suite's default */
     double n, t_end, max_wall;
     const char* out;
@@ -569,7 +571,10 @@ static int suite_tts(const opts* o) {
     const unsigned solvers = o->tts_solvers ? o->tts_solvers
                                             : o->quick ? (unsigned)quick_solvers
                                                        : (1u << TTS_NSOLVER) - 1;
-    const unsigned precs = o->precisions ? o->precisions : 3u; /* 1 double, 2 float */
+    /* 1 double, 2 float; make bench (tts among the default suites, full mode): double only */
+    const unsigned precs = o->precisions               ? o->precisions
+                           : o->suites_default && !o->quick ? 1u
+                                                            : 3u;
     const double t_end = o->t_end > 0 ? o->t_end : o->quick ? 0.1 : 1.0;
     const int P = max_threads();
     int threads[2], nthreads = 0, sc, sv, pr, ti, ncell = 0, ok = 1;
@@ -584,6 +589,8 @@ static int suite_tts(const opts* o) {
     if (!f) return 0;
     if (o->threads_set)
         threads[nthreads++] = o->threads;
+    else if (o->suites_default && !o->quick) /* make bench: 2 threads only */
+        threads[nthreads++] = P >= 2 ? 2 : 1;
     else {
         threads[nthreads++] = 1;
         if (P >= 2) threads[nthreads++] = 2;
@@ -808,9 +815,11 @@ int main(int argc, char** argv) {
         return 2;
     }
     if (o.n <= 0) o.n = o.quick ? 2e4 : 1e5;
-    if (!any)
+    if (!any) {
         for (k = 0; k < NDEFAULT; ++k)
             want[k] = 1;
+        o.suites_default = 1;
+    }
     printf("sph.h %d.%d.%d bench: %s mode, %d processor(s), target %.0f fluid particles, median of "
            "%d%s\n",
            SPH_VERSION_MAJOR, SPH_VERSION_MINOR, SPH_VERSION_PATCH, o.quick ? "quick" : "full",
