@@ -9,6 +9,8 @@
 #   make bench     the benchmark driver (bench/bench.c: speed against a baseline, scaling, memory,
 #                  cost growth) and the Taylor-Green convergence study, results in bench/results/
 #   make bench-quick  the driver at small sizes (under a minute), into out/bench-quick/
+#   make bench-tts time to solution per solver on the 2D and 3D dam breaks (59k particles
+#                  included: hours), into bench/results/tts.*
 #   make pareto    error against CPU time per solver and scene, stability maps (bench/pareto.c,
 #                  about 11 minutes), into bench/results/; make pareto-quick: small, out/pareto-quick/
 #   make paraview  the dam break as a ParaView time series: out/paraview/dambreak.pvd
@@ -63,8 +65,9 @@ validate: $(B)/tests
 
 BENCH_N ?= 80
 # make bench: every suite of the benchmark driver (sph.h against its baseline, scaling, search,
-# float, memory, cost growth, optional physics) and the Taylor-Green convergence study, CSV and
-# SVG into bench/results/ (about 15 minutes on 2 cores). make bench-quick: the same suites at
+# float, memory, cost growth, optional physics, time to solution on the 2D dam break in double
+# on 2 threads) and the Taylor-Green convergence study, CSV and SVG into bench/results/ (about
+# 15 minutes on 2 cores; the 3D time-to-solution runs are behind make bench-tts). make bench-quick: the same suites at
 # small sizes into out/bench-quick/ (under a minute; CI runs it so the log shows a regression).
 bench: $(B)/bench $(B)/convergence
 	mkdir -p bench/results
@@ -74,6 +77,17 @@ bench: $(B)/bench $(B)/convergence
 bench-quick: $(B)/bench
 	mkdir -p out/bench-quick
 	./$(B)/bench --quick --repeats 1 --out out/bench-quick
+
+# make bench-tts: the tts suite (time to solution through sph_advance with the library's
+# defaults) for every scene, solver, precision and 1 and 2 threads, SPlisHSPlasH's 59k-particle
+# DamBreakModel included: 60 runs, several hours on 2 cores (a 59k run takes minutes to hours;
+# each run stops after TTS_MAX_WALL wall-clock seconds and then reports the time it reached).
+# One cell: ./build/bench tts --scene 3d-59k --solver dfsph --precision double --threads 2
+TTS_MAX_WALL ?= 1500
+.PHONY: bench-tts
+bench-tts: $(B)/bench
+	mkdir -p bench/results
+	./$(B)/bench tts --scene all --max-wall $(TTS_MAX_WALL) --out bench/results > bench/results/tts.txt; st=$$?; cat bench/results/tts.txt; exit $$st
 
 BENCH_SRC = bench/bench.c bench/bench_float.c
 $(B)/bench: $(BENCH_SRC) bench/bench_core.h bench/bench_types.h bench/baseline.h bench/svg.h sph.h examples/scenes.h | $(B)

@@ -14,11 +14,24 @@
      model       the 2D dam break with one optional piece of physics on at a time: bytes, time
      run         one measurement: --scene, --n, --solver, --threads, --repeats, --steps
      iisph-sweep Meiers 2025's Table 2 for our IISPH (time step against iterations and cost)
+     tts         time to solution: the dam break through sph_advance with the library's defaults
+                 (frames of 1/50 s) to --t-end, per solver (wcsph, pcisph-enh, pcisph, iisph,
+                 dfsph), double and float, 1 and 2 threads: wall-clock seconds per simulated
+                 second, time reached (a run stops at its first error and reports it), sub-steps,
+                 retries, density error, particles outside the container. Scenes: 2d (examples/
+                 dambreak.c's), 3d-6k and 3d-59k (SPlisHSPlasH's DamBreakModel at dx 0.05 and
+                 0.025 m); default 2d only (make bench-tts runs all), --quick: 2d at 10
+                 particles per a to 0.1 s, wcsph and dfsph; among the default suites of a full
+                 run (make bench) double and 2 threads only. Select cells with --scene, --solver
+                 (comma lists or all), --precision, --threads; --max-wall S stops a run after S
+                 wall-clock seconds (it reports the time it reached)
    Options: --quick (small sizes, < 1 minute), --out DIR (CSV and SVG; default bench/results),
-            --n N, --scene S, --solver S, --threads T, --repeats R, --steps K
+            --n N, --scene S, --solver S, --threads T, --repeats R, --steps K, --t-end T (tts:
+            simulated seconds, default 1), --max-wall S, --precision double|float|all
    Every timing is the median over the repeats of a wall-clock time per step; runs that are
    compared (ours against the baseline, double against float) alternate inside one repeat loop,
-   so a slow minute on a shared machine hits both. */
+   so a slow minute on a shared machine hits both. tts is the exception: one run per cell (each
+   is thousands of steps), printed with the host's load average. */
 #define SPH_IMPLEMENTATION
 #include "sph.h"
 #include "examples/scenes.h"
@@ -33,10 +46,14 @@
 #include <string.h>
 
 int bench_run_f(int scene, int solver, double target, int warm, int steps, bench_result* r);
+int bench_tts_f(int scene, int solver, int quick, double t_end, double max_wall, double progress,
+                tts_result* r);
 
 typedef struct opts {
-    int quick, repeats, steps, threads, scene, solver;
-    double n;
+    int quick, repeats, steps, threads, threads_set, scene, solver;
+    int suites_default; /* no suite named: tts runs a smaller default set (see suite_tts) */
+    unsigned tts_scenes, tts_solvers, precisions; /* bit masks (tts); 0 = the suite's default */
+    double n, t_end, max_wall;
     const char* out;
 } opts;
 
@@ -535,6 +552,147 @@ static int suite_iisph_sweep(const opts* o) {
     return 1;
 }
 
+/* The host's 1-minute load average (Linux; 0 elsewhere): other work on a shared machine. */
+static double load_average(void) {
+    double l = 0;
+    FILE* f = fopen("/proc/loadavg", "r");
+    if (!f) return 0;
+    if (fscanf(f, "%lf", &l) != 1) l = 0;
+    fclose(f);
+    return l;
+}
+
+/* Time to solution: each scene run to --t-end through sph_advance with the library's defaults
+   (no max_dt, no tuned tolerance: what a user gets), one frame (1/50 s) per call. A run stops
+   at its first error, reported with the time it reached. */
+static int suite_tts(const opts* o) {
+    static const int quick_solvers = (1 << TTS_WCSPH) | (1 << TTS_DFSPH);
+    const unsigned scenes = o->tts_scenes ? o->tts_scenes : 1u << TTS_DAM2D; /* 3D: --scene */
+    const unsigned solvers = o->tts_solvers ? o->tts_solvers
+                                            : o->quick ? (unsigned)quick_solvers
+                                                       : (1u << TTS_NSOLVER) - 1;
+    /* 1 double, 2 float; make bench (tts among the default suites, full mode): double only */
+    const unsigned precs = o->precisions               ? o->precisions
+                           : o->suites_default && !o->quick ? 1u
+                                                            : 3u;
+    const double t_end = o->t_end > 0 ? o->t_end : o->quick ? 0.1 : 1.0;
+    const int P = max_threads();
+    int threads[2], nthreads = 0, sc, sv, pr, ti, ncell = 0, ok = 1;
+    /* chart: one series per scene x precision x thread count (at most 3 x 2 x 2 = 12) */
+    double X[TTS_NSCENE * 4][TTS_NSOLVER], Y[TTS_NSCENE * 4][TTS_NSOLVER];
+    int used[TTS_NSCENE * 4] = {0};
+    char path[512];
+    FILE* f = csv_open(o, "tts.csv",
+                       "scene,solver,precision,threads,fluid,walls,t_end,time_reached,status,"
+                       "wall_s,s_per_sim_s,frames,substeps,retries,dt_mean,dt_min,iters_mean,"
+                       "err_mean,comp_mean,comp_max,outside_max,outside_depth_dx,capped,load1,error");
+    if (!f) return 0;
+    if (o->threads_set)
+        threads[nthreads++] = o->threads;
+    else if (o->suites_default && !o->quick) /* make bench: 2 threads only */
+        threads[nthreads++] = P >= 2 ? 2 : 1;
+    else {
+        threads[nthreads++] = 1;
+        if (P >= 2) threads[nthreads++] = 2;
+    }
+    for (sc = 0; sc < TTS_NSCENE * 4; ++sc)
+        for (sv = 0; sv < TTS_NSOLVER; ++sv) {
+            X[sc][sv] = sv + 1;
+            Y[sc][sv] = NAN;
+        }
+    printf("\n== time to solution: sph_advance with the library's defaults, frames of %.2f s, to "
+           "t = %.2f s; %d processor(s)\n",
+           TTS_FRAME, t_end, P);
+    for (sc = 0; sc < TTS_NSCENE; ++sc)
+        if (scenes >> sc & 1) printf("  %-7s %s\n", tts_scene_names[sc], tts_scene_what[sc]);
+    printf("  s/sim-s: wall-clock seconds per simulated second (inside sph_advance); comp: mean "
+           "over frames of the mean max(rho/rho0-1, 0) and its max; |err|: mean |rho/rho0-1|; "
+           "out: most fluid particles outside the container at a frame end, depth: the farthest "
+           "one [dx]; load: 1-minute load average after the run (the host is shared)\n");
+    printf("  %-7s %-10s %-6s %3s %7s %6s %9s %8s %8s %7s %6s %7s %7s %7s %5s %6s %5s  %s\n",
+           "scene", "solver", "prec", "thr", "fluid", "walls", "s/sim-s", "t [s]", "substeps",
+           "retries", "iters", "|err|%", "comp %", "cmax %", "out", "depth", "load", "status");
+    fflush(stdout);
+    for (sc = 0; sc < TTS_NSCENE; ++sc) {
+        if (!(scenes >> sc & 1)) continue;
+        for (sv = 0; sv < TTS_NSOLVER; ++sv) {
+            if (!(solvers >> sv & 1)) continue;
+            for (pr = 0; pr < 2; ++pr) {
+                if (!(precs >> pr & 1)) continue;
+                for (ti = 0; ti < nthreads; ++ti) {
+                    tts_result run, *r = &run;
+                    const int series = sc * 4 + pr * 2 + ti;
+                    const char* c;
+                    double rt;
+                    set_threads(threads[ti]);
+                    if (pr == 0)
+                        tts_d(sc, sv, o->quick, t_end, o->max_wall, o->quick ? 0 : 60, r);
+                    else
+                        bench_tts_f(sc, sv, o->quick, t_end, o->max_wall, o->quick ? 0 : 60, r);
+                    ++ncell;
+                    rt = r->time > 0 ? r->wall_s / r->time : NAN;
+                    printf("  %-7s %-10s %-6s %3d %7.0f %6.0f %9.3g %8.3f %8.0f %7.0f %6.1f %7.3f "
+                           "%7.3f %7.2f %5.0f %6.2f %5.1f  %s\n",
+                           tts_scene_names[sc], tts_solver_names[sv], pr ? "float" : "double",
+                           threads[ti], r->n, r->nb, rt, r->time, r->substeps, r->retries,
+                           r->its_mean, 100 * r->err_mean, 100 * r->comp_mean, 100 * r->comp_max,
+                           r->outside_max, r->outside_depth, load_average(),
+                           r->status > 0   ? sph_status_string((sph_status)r->status)
+                           : r->status < 0 ? "scene not built"
+                           : r->capped     ? "stopped at --max-wall"
+                                           : "ok");
+                    if (r->status) printf("          %s\n", r->error);
+                    fflush(stdout);
+                    fprintf(f,
+                            "%s,%s,%s,%d,%.0f,%.0f,%.4f,%.6f,%s,%.3f,%.6g,%d,%.0f,%.0f,%.6g,%.6g,"
+                            "%.2f,%.6g,%.6g,%.6g,%.0f,%.3f,%d,%.2f,\"",
+                            tts_scene_names[sc], tts_solver_names[sv], pr ? "float" : "double",
+                            threads[ti], r->n, r->nb, t_end, r->time,
+                            r->status > 0   ? sph_status_string((sph_status)r->status)
+                            : r->status < 0 ? "scene not built"
+                                            : "ok",
+                            r->wall_s, rt, r->frames, r->substeps, r->retries,
+                            r->substeps > r->retries ? r->time / (r->substeps - r->retries) : 0,
+                            r->dt_min, r->its_mean, r->err_mean, r->comp_mean, r->comp_max,
+                            r->outside_max, r->outside_depth, r->capped, load_average());
+                    for (c = r->error; *c; ++c) /* the message, CSV-quoted */
+                        if (*c == '"')
+                            fputs("\"\"", f);
+                        else
+                            fputc(*c, f);
+                    fputs("\"\n", f);
+                    fflush(f);
+                    if (r->status == 0 && !r->capped) Y[series][sv] = rt;
+                    used[series] = 1;
+                    if (r->status < 0) ok = 0;
+                }
+            }
+        }
+    }
+    fclose(f);
+    set_threads(1);
+    {
+        svg_chart ch;
+        char label[64];
+        svg_begin(&ch, "Time to solution, dam break, sph_advance with defaults",
+                  "1 WCSPH, 2 PCISPH enh., 3 PCISPH orig., 4 IISPH, 5 DFSPH",
+                  "wall s per simulated s (runs that finished)");
+        svg_log(&ch, 1);
+        svg_range(&ch, 0, 0.5, TTS_NSOLVER + 0.5);
+        for (sc = 0; sc < TTS_NSCENE * 4; ++sc) {
+            if (!used[sc]) continue;
+            snprintf(label, sizeof label, "%s %s %dt", tts_scene_names[sc / 4],
+                     sc % 4 >= 2 ? "float" : "double", threads[sc % 2]);
+            svg_series(&ch, X[sc], Y[sc], TTS_NSOLVER, SVG_LINE_MARKS, label);
+        }
+        out_path(o, "tts.svg", path, sizeof path);
+        svg_write(&ch, path);
+        svg_free(&ch);
+    }
+    printf("%d run(s); CSV %s/tts.csv, chart %s/tts.svg\n", ncell, o->out, o->out);
+    return ok;
+}
+
 static int find_name(const char* s, const char* const* names, int n) {
     int k;
     for (k = 0; k < n; ++k)
@@ -542,13 +700,34 @@ static int find_name(const char* s, const char* const* names, int n) {
     return -1;
 }
 
+/* A comma-separated list of names ("all": every one) as a bit mask; 0 if a name is unknown. */
+static unsigned name_mask(const char* s, const char* const* names, int n) {
+    unsigned m = 0;
+    char buf[64];
+    if (strcmp(s, "all") == 0) return (1u << n) - 1;
+    while (*s) {
+        size_t len = strcspn(s, ",");
+        int k;
+        if (len == 0 || len >= sizeof buf) return 0;
+        memcpy(buf, s, len);
+        buf[len] = 0;
+        if ((k = find_name(buf, names, n)) < 0) return 0;
+        m |= 1u << k;
+        s += len;
+        if (*s == ',') ++s;
+    }
+    return m;
+}
+
 int main(int argc, char** argv) {
-    static const char* const suites[] = {"throughput", "scaling", "search", "float",      "memory",
-                                         "growth",     "model",   "run",    "iisph-sweep"};
-    enum { NSUITE = 9, NDEFAULT = 7 };
-    int (*const fns[NSUITE])(const opts*) = {suite_throughput, suite_scaling, suite_search,
-                                             suite_float,      suite_memory,  suite_growth,
-                                             suite_model,      suite_run,     suite_iisph_sweep};
+    static const char* const suites[] = {"throughput", "scaling", "search", "float", "memory",
+                                         "growth",     "model",   "tts",    "run",   "iisph-sweep"};
+    static const char* const precisions[] = {"double", "float"};
+    enum { NSUITE = 10, NDEFAULT = 8 };
+    int (*const fns[NSUITE])(const opts*) = {
+        suite_throughput, suite_scaling, suite_search, suite_float,     suite_memory,
+        suite_growth,     suite_model,   suite_tts,    suite_run,       suite_iisph_sweep};
+    const char *scene_arg = NULL, *solver_arg = NULL;
     const char* scene_names[BENCH_NSCENE];
     const char* solver_names[BENCH_NSOLVER];
     int want[NSUITE] = {0}, any = 0, k, ok = 1;
@@ -582,20 +761,24 @@ int main(int argc, char** argv) {
             o.repeats = atoi(v);
         else if (strcmp(a, "--steps") == 0)
             o.steps = atoi(v);
-        else if (strcmp(a, "--threads") == 0)
+        else if (strcmp(a, "--threads") == 0) {
             o.threads = atoi(v);
-        else if (strcmp(a, "--scene") == 0) {
-            if ((o.scene = find_name(v, scene_names, BENCH_NSCENE)) < 0) {
-                fprintf(stderr, "bench: unknown scene %s (dambreak2d, dambreak3d, hydrostatic2d)\n",
+            o.threads_set = 1;
+        } else if (strcmp(a, "--t-end") == 0)
+            o.t_end = atof(v);
+        else if (strcmp(a, "--max-wall") == 0)
+            o.max_wall = atof(v);
+        else if (strcmp(a, "--precision") == 0) {
+            if (!(o.precisions = name_mask(v, precisions, 2))) {
+                fprintf(stderr, "bench: unknown precision %s (double, float, double,float, all)\n",
                         v);
                 return 2;
             }
-        } else if (strcmp(a, "--solver") == 0) {
-            if ((o.solver = find_name(v, solver_names, BENCH_NSOLVER)) < 0) {
-                fprintf(stderr, "bench: unknown solver %s (wcsph, pcisph, pcisph-enh, iisph)\n", v);
-                return 2;
-            }
-        } else if ((s = find_name(a, suites, NSUITE)) >= 0) {
+        } else if (strcmp(a, "--scene") == 0)
+            scene_arg = v;
+        else if (strcmp(a, "--solver") == 0)
+            solver_arg = v;
+        else if ((s = find_name(a, suites, NSUITE)) >= 0) {
             want[s] = any = 1;
             continue;
         } else {
@@ -606,14 +789,37 @@ int main(int argc, char** argv) {
         }
         ++k;
     }
-    if (o.repeats < 1 || o.repeats > 16 || o.threads < 1) {
-        fprintf(stderr, "bench: bad --repeats/--threads\n");
+    if (o.repeats < 1 || o.repeats > 16 || o.threads < 1 || o.t_end < 0 || o.max_wall < 0) {
+        fprintf(stderr, "bench: bad --repeats/--threads/--t-end/--max-wall\n");
+        return 2;
+    }
+    /* --scene and --solver: the run suite's names, or for tts a list of its own */
+    if (scene_arg && (o.scene = find_name(scene_arg, scene_names, BENCH_NSCENE)) < 0 &&
+        !(o.tts_scenes = name_mask(scene_arg, tts_scene_names, TTS_NSCENE))) {
+        fprintf(stderr,
+                "bench: unknown scene %s (run: dambreak2d, dambreak3d, hydrostatic2d; tts: a "
+                "list of 2d, 3d-6k, 3d-59k, or all)\n",
+                scene_arg);
+        return 2;
+    }
+    if (solver_arg) o.solver = find_name(solver_arg, solver_names, BENCH_NSOLVER);
+    if (want[8] && (o.scene < 0 || o.solver < 0)) {
+        fprintf(stderr, "bench: run needs a scene and solver of its own (see --scene, --solver)\n");
+        return 2;
+    }
+    if (solver_arg && !(o.tts_solvers = name_mask(solver_arg, tts_solver_names, TTS_NSOLVER))) {
+        fprintf(stderr,
+                "bench: unknown solver %s (run: wcsph, pcisph, pcisph-enh, iisph; tts: a list "
+                "of those and dfsph, or all)\n",
+                solver_arg);
         return 2;
     }
     if (o.n <= 0) o.n = o.quick ? 2e4 : 1e5;
-    if (!any)
+    if (!any) {
         for (k = 0; k < NDEFAULT; ++k)
             want[k] = 1;
+        o.suites_default = 1;
+    }
     printf("sph.h %d.%d.%d bench: %s mode, %d processor(s), target %.0f fluid particles, median of "
            "%d%s\n",
            SPH_VERSION_MAJOR, SPH_VERSION_MINOR, SPH_VERSION_PATCH, o.quick ? "quick" : "full",

@@ -390,3 +390,145 @@ BENCH_FN double BX(bytes_3d_multiphase)(double target) {
     sph_world_free(&w);
     return bytes;
 }
+
+/* ---- time to solution (the tts suite) -------------------------------------------------------- */
+
+/* Builds a tts scene for a solver with the library's defaults (only the scene's geometry,
+   material and the solver's preset are set), the domain box set to the container's interior so
+   that w.stats.n_outside counts fluid that left it. 3D: SPlisHSPlasH's DamBreakModel, a cube of
+   (1/dx - 1)^3 particles (39^3 = 59319 at dx 0.025 m, 19^3 = 6859 at 0.05 m) in the corner of a
+   closed 4 x 3 x 1.5 m box of wall particles, nu = 0.01 m^2/s, gravity -9.81 m/s^2 in y. */
+BENCH_FN int BX(tts_build)(sph_world* w, int scene, int solver, int quick) {
+    const int dim = scene == TTS_DAM2D ? 2 : 3;
+    sph_world_def def = sph_world_def_default(dim);
+    switch (solver) {
+    case TTS_PCISPH_ENH:
+        sph_world_def_pcisph(&def, 1);
+        break;
+    case TTS_PCISPH:
+        sph_world_def_pcisph(&def, 0);
+        break;
+    case TTS_IISPH:
+        def.solver = SPH_SOLVER_IISPH;
+        break;
+    case TTS_DFSPH:
+        def.solver = SPH_SOLVER_DFSPH;
+        break;
+    default:
+        break;
+    }
+    if (scene == TTS_DAM2D) { /* examples/dambreak.c's scene: a = 0.5 m, 40 particles per a */
+        const double a = 0.5;
+        def.domain_hi[0] = (sph_real)(5 * a);
+        def.domain_hi[1] = (sph_real)(3 * a);
+        if (scene_dam_break(w, def, a, quick ? 10 : 40, NULL) != SPH_OK) return 0;
+        return 1;
+    }
+    {
+        const double dx = scene == TTS_DAM3D_FINE ? 0.025 : 0.05;
+        const int m = (int)floor(1 / dx + 0.5) - 1;
+        sph_real lo[3] = {0, 0, 0}, hi[3], box[3];
+        sph_phase water;
+        int ph, k;
+        memset(&water, 0, sizeof(water));
+        water.rest_density = 1000;
+        water.viscosity = (sph_real)0.01;
+        def.spacing = (sph_real)dx;
+        box[0] = 4;
+        box[1] = 3;
+        box[2] = (sph_real)1.5;
+        for (k = 0; k < 3; ++k) {
+            hi[k] = (sph_real)(m * dx);
+            def.domain_hi[k] = box[k];
+        }
+        if (sph_world_init(w, &def) != SPH_OK) goto fail;
+        ph = sph_world_add_phase(w, &water);
+        if (ph < 0 || sph_fill_box(w, ph, lo, hi) != SPH_OK ||
+            sph_add_wall_box(w, lo, box, 0, 0) != SPH_OK || sph_set_hydrostatic(w) != SPH_OK)
+            goto fail;
+        return 1;
+    fail:
+        snprintf(scene_error, sizeof scene_error, "%s", w->error);
+        sph_world_free(w);
+        return 0;
+    }
+}
+
+/* Runs a tts scene to t_end through sph_advance in frames of TTS_FRAME, stopping at the first
+   error (the world is then as at the end of the last good frame: r->time is the time reached)
+   or once more than max_wall wall-clock seconds (0: no limit) were spent. progress > 0: a line on
+   stderr every `progress` wall-clock seconds. Returns 1 if the scene was built. */
+BENCH_FN int BX(tts)(int scene, int solver, int quick, double t_end, double max_wall,
+                     double progress, tts_result* r) {
+    sph_world w;
+    double rho0, next_report = progress, sum_err = 0, sum_comp = 0, sum_its = 0;
+    int f, frames;
+    memset(r, 0, sizeof(*r));
+    if (!BX(tts_build)(&w, scene, solver, quick)) {
+        r->status = -1;
+        snprintf(r->error, sizeof r->error, "%s", scene_error);
+        return 0;
+    }
+    r->n = (double)w.n;
+    r->nb = (double)w.nb;
+    rho0 = (double)w.phases[0].rest_density;
+    frames = (int)ceil(t_end / TTS_FRAME - 1e-9);
+    for (f = 0; f < frames; ++f) {
+        const double target = f + 1 == frames ? t_end : (f + 1) * TTS_FRAME;
+        double t0, e_sum = 0, c_sum = 0, c_max = -1;
+        sph_status s;
+        size_t i;
+        w.stats.substeps = w.stats.retries = 0; /* set by the call (not by every failure path) */
+        t0 = bench_now();
+        s = sph_advance(&w, (sph_real)(target - w.time));
+        r->wall_s += bench_now() - t0;
+        r->substeps += s == SPH_ERR_BUDGET ? w.def.max_substeps : w.stats.substeps;
+        r->retries += w.stats.retries;
+        if (w.stats.dt_min > 0 && (r->dt_min == 0 || w.stats.dt_min < r->dt_min))
+            r->dt_min = w.stats.dt_min;
+        if (s != SPH_OK) {
+            r->status = (int)s;
+            snprintf(r->error, sizeof r->error, "%s", w.error);
+            break;
+        }
+        for (i = 0; i < w.n; ++i) {
+            const double e = (double)w.rho[i] / rho0 - 1;
+            int k;
+            e_sum += fabs(e);
+            c_sum += e > 0 ? e : 0;
+            if (e > c_max) c_max = e;
+            for (k = 0; k < w.dim; ++k) { /* depth outside the container (w.def.domain) */
+                const double x = (double)w.x[i * (size_t)w.dim + (size_t)k];
+                const double d = fmax((double)w.def.domain_lo[k] - x,
+                                      x - (double)w.def.domain_hi[k]) / (double)w.dx;
+                if (d > r->outside_depth) r->outside_depth = d;
+            }
+        }
+        sum_err += w.n ? e_sum / (double)w.n : 0;
+        sum_comp += w.n ? c_sum / (double)w.n : 0;
+        sum_its += w.stats.iterations;
+        if (c_max > r->comp_max) r->comp_max = c_max;
+        if ((double)w.stats.n_outside > r->outside_max) r->outside_max = (double)w.stats.n_outside;
+        r->frames = f + 1;
+        if (progress > 0 && r->wall_s >= next_report) {
+            fprintf(stderr, "  [%s %s %s] t = %.3f s after %.0f s wall, %.0f sub-steps, %.0f "
+                            "retries\n",
+                    tts_scene_names[scene], tts_solver_names[solver],
+                    sizeof(sph_real) == sizeof(float) ? "float" : "double", w.time, r->wall_s,
+                    r->substeps, r->retries);
+            next_report += progress;
+        }
+        if (max_wall > 0 && r->wall_s > max_wall && f + 1 < frames) {
+            r->capped = 1;
+            break;
+        }
+    }
+    r->time = w.time;
+    if (r->frames > 0) {
+        r->err_mean = sum_err / r->frames;
+        r->comp_mean = sum_comp / r->frames;
+        r->its_mean = sum_its / r->frames;
+    }
+    sph_world_free(&w);
+    return 1;
+}

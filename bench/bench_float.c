@@ -14,3 +14,7 @@
 int bench_run_f(int scene, int solver, double target, int warm, int steps, bench_result* r) {
     return run_f(scene, solver, target, warm, steps, r);
 }
+int bench_tts_f(int scene, int solver, int quick, double t_end, double max_wall, double progress,
+                tts_result* r) {
+    return tts_f(scene, solver, quick, t_end, max_wall, progress, r);
+}

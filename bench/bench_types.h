@@ -50,6 +50,39 @@ typedef struct bench_result {
     uint64_t hash;          /* state after the timed steps                              */
 } bench_result;
 
+/* Time to solution (the tts suite): scenes and solvers as a user sets them up, library defaults. */
+enum { TTS_DAM2D, TTS_DAM3D_COARSE, TTS_DAM3D_FINE, TTS_NSCENE };
+enum { TTS_WCSPH, TTS_PCISPH_ENH, TTS_PCISPH, TTS_IISPH, TTS_DFSPH, TTS_NSOLVER };
+
+static const char* const tts_scene_names[TTS_NSCENE] = {"2d", "3d-6k", "3d-59k"};
+static const char* const tts_scene_what[TTS_NSCENE] = {
+    "scene_dam_break: column 0.5 x 1 m in a 2.5 x 1.5 m tank, dx = a/40 (a/10 --quick)",
+    "DamBreakModel: 19^3 cube, dx 0.05 m, in a 4 x 3 x 1.5 m box, nu 0.01",
+    "DamBreakModel: 39^3 cube, dx 0.025 m, in a 4 x 3 x 1.5 m box, nu 0.01"};
+static const char* const tts_solver_names[TTS_NSOLVER] = {"wcsph", "pcisph-enh", "pcisph",
+                                                          "iisph", "dfsph"};
+
+#define TTS_FRAME 0.02 /* one frame, 1/50 s: the duration of each sph_advance call */
+
+typedef struct tts_result {
+    double n, nb;          /* fluid and wall particles                                          */
+    double time;           /* simulated time reached [s]                                        */
+    double wall_s;         /* wall-clock seconds inside sph_advance, the failed call included   */
+    double substeps;       /* sub-steps over all calls, retries included (a failed call's too)  */
+    double retries;        /* sub-steps rolled back                                             */
+    double dt_min;         /* smallest successful sub-step [s]                                  */
+    double err_mean;       /* mean over frame ends of the mean |rho/rho0 - 1|                   */
+    double comp_mean;      /* mean over frame ends of the mean max(rho/rho0 - 1, 0)             */
+    double comp_max;       /* max over frame ends and particles of rho/rho0 - 1                 */
+    double its_mean;       /* mean over frame ends of the last sub-step's solver iterations     */
+    double outside_max;    /* max over frame ends of the fluid particles outside the container  */
+    double outside_depth;  /* the farthest any was outside it [particle spacings]               */
+    int frames;            /* frames completed                                                  */
+    int status;            /* sph_status of the call that failed (0: none), -1: scene not built */
+    int capped;            /* stopped by --max-wall                                             */
+    char error[256];       /* w.error of the failed call                                        */
+} tts_result;
+
 static double bench_now(void) {
 #ifdef _OPENMP
     return omp_get_wtime();
