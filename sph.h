@@ -430,8 +430,10 @@ typedef double sph_real;
 #define SPH_MAX_PHASES 16
 #endif
 
-/* Size of the error message buffer kept in the world. */
-#define SPH_ERROR_SIZE 256
+/* Size of the error message buffer kept in the world: room for sph_advance's account of a
+   failed sub-step together with the failing step's own message (at 256 bytes the reason, e.g.
+   which wall a particle entered, was cut off). */
+#define SPH_ERROR_SIZE 512
 
 #ifdef __cplusplus
 extern "C" {
