@@ -6438,6 +6438,24 @@ static sph_status sph__step_dfsph(sph_world* w, sph_real dt) {
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) w->p[i] = w->p[i] > 0 ? sph__warm(w) * w->p[i] : 0;
     it = sph__dfsph_solve(w, &c, w->priv.df_vs, dt, 1, w->def.min_iterations, tol, &err);
+    /* a particle still predicted beyond max_compression fails this step, not the next one
+       (the density check of sph__integrate reads rho at the step's start); serial */
+    if (w->def.max_compression > 0) {
+        size_t q, worst = 0;
+        sph_real cmax = 0;
+        for (q = 0; q < w->n; ++q) {
+            const sph_real r = w->drho[q] * c.pc[c.ph[q]].inv_rho0;
+            if (r > cmax) { cmax = r; worst = q; }
+        }
+        if (cmax > w->def.max_compression)
+            return sph__fail(w, SPH_ERR_UNSTABLE, (long)worst,
+                             "step %llu (t = %g s): DFSPH's constant-density solve ends with "
+                             "fluid particle %zu (id %u) predicted at rho/rho0 = %g "
+                             "(max_compression %g) after %d iterations: time step too large",
+                             (unsigned long long)w->steps + 1, w->time + (double)dt, worst,
+                             (unsigned)w->id[worst], 1 + (double)cmax,
+                             (double)w->def.max_compression, it);
+    }
     sph__record_nonpressure(w);
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)nD; ++i) w->a[i] += w->priv.ap[i]; /* for the diagnostics */
