@@ -884,6 +884,17 @@ typedef struct sph_world_def {
                                   the step with SPH_ERR_UNSTABLE naming it; lattice walls of
                                   given volumes only (not SPH_BVOL_AKINCI, whose single layers
                                   weigh as a full wall). 0 = off                                */
+    sph_real wall_contact;     /* a fluid particle's centre stays at least wall_contact dx from
+                                  every boundary particle's centre [-]: a step that ends closer
+                                  moves it back out along the line between them and removes its
+                                  velocity into that particle (relative to the wall's), a
+                                  free-slip, inelastic contact (sph__wall_contact). Default
+                                  0.02 + sqrt(dim)/2 (0.73 in 2D, 0.89 in 3D: a particle over the
+                                  hollow between the particles of a wall lattice at dx keeps its
+                                  centre on the fluid side of the wall's face; a fluid lattice
+                                  sits 1 dx from its wall lattice); 0 = off; [0, 1.5]. Walls
+                                  sampled at up to sqrt(2) wall_contact dx (3D; 2 wall_contact
+                                  dx in 2D) stay watertight                                      */
     int max_substeps;          /* sph_advance: at most this many sub-steps (retries included) per
                                   call, else SPH_ERR_BUDGET with the world as before the call;
                                   default 100000; [1, 2^30]                                      */
@@ -934,6 +945,8 @@ typedef struct sph_stats {
     size_t pairs;             /* fluid-fluid neighbour pairs (each counted from both sides); with
                                  SPH_SCHEME_SECOND_ORDER those of its lists, which reach 0.2 dx
                                  beyond the support                                              */
+    size_t contacts;          /* fluid particles that def.wall_contact moved back out of a wall
+                                 in the step                                                     */
     size_t n_outside;         /* fluid particles outside the domain box in a bounded, non-periodic
                                  direction (kept, still simulated)                               */
     double stage_time[SPH_STAGE_COUNT]; /* wall-clock seconds per stage                            */
@@ -957,6 +970,10 @@ typedef struct sph_stats {
                                  other solvers                                                  */
     double divergence_error;  /* DFSPH: mean max(D rho/Dt, 0) dt / rho0 after its divergence
                                  solve [-]; the other steps leave it unchanged                   */
+    double ke_low, ke_high;   /* PCISPH, IISPH, DFSPH without forcing: the least and the largest
+                                 kinetic energy since the forcing stopped [J] (the energy check,
+                                 sph__energy_check)                                              */
+    long unforced_steps;      /* steps since then (0: forced, or none yet)                       */
 } sph_stats;
 
 /* Private state (do not touch). */
@@ -2401,6 +2418,9 @@ SPHDEF sph_world_def sph_world_def_default(int dim) {
     d.max_speed = 0;
     d.max_displacement = 1;
     d.check_walls = 1;
+    /* sqrt(dim)/2: a particle over the hollow between wall particles of a lattice at dx then
+       keeps its centre on the fluid side of the wall's face (sph__wall_contact) */
+    d.wall_contact = (sph_real)(0.02 + 0.5 * sqrt((double)(dim >= 1 && dim <= 3 ? dim : 3)));
     d.max_substeps = 100000;
     d.boundary_pressure = SPH_BP_AUTO;
     d.boundary_volume = SPH_BVOL_GIVEN;
@@ -2579,6 +2599,10 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
                (double)d->max_compression);
     SPH__CHECK(sph__finite((double)d->max_speed) && d->max_speed >= 0,
                "sph_world_def.max_speed = %g: must be finite and >= 0", (double)d->max_speed);
+    SPH__CHECK(sph__finite((double)d->wall_contact) && d->wall_contact >= 0 &&
+                   d->wall_contact <= SPH__R(1.5),
+               "sph_world_def.wall_contact = %g: must be in [0, 1.5] (spacings)",
+               (double)d->wall_contact);
     SPH__CHECK(sph__finite((double)d->max_displacement) && d->max_displacement >= 0,
                "sph_world_def.max_displacement = %g: must be finite and >= 0",
                (double)d->max_displacement);
@@ -4515,7 +4539,8 @@ static sph_status sph__boundary_motion(sph_world* w, double t) {
    `final`, also the step's diagnostics and blow-up detection. Reductions run over fixed blocks
    combined in block order, so the result does not depend on the number of threads. */
 enum { SPH__RED_KE, SPH__RED_ERRSUM, SPH__RED_ERRMAX, SPH__RED_COMP, SPH__RED_V2MAX,
-       SPH__RED_A2MAX, SPH__RED_OUT, SPH__RED_BAD, SPH__RED_KIND, SPH__RED_N };
+       SPH__RED_A2MAX, SPH__RED_OUT, SPH__RED_CONTACT, SPH__RED_WREL, SPH__RED_BAD, SPH__RED_KIND,
+       SPH__RED_N };
 enum { SPH__BAD_NONE, SPH__BAD_NONFINITE, SPH__BAD_DENSITY, SPH__BAD_COMPRESSION, SPH__BAD_SPEED,
        SPH__BAD_ENERGY, SPH__BAD_DISPLACEMENT, SPH__BAD_WALL };
 
@@ -4542,6 +4567,121 @@ static sph_real sph__wall_fraction(const sph__ctx* c, const sph_real* xi, size_t
 }
 
 
+/* Wall contact (def.wall_contact). The pressure solvers keep a fluid particle off a wall only as
+   far as its density needs: a particle short of fluid neighbours (a splash, the one-particle sheet
+   a dam break spreads along the floor) reaches rho0 only once the wall supplies the missing
+   volume, i.e. on or past the wall's first layer (wall volume fraction 0.78 there, 0.5 on the
+   wall's face), and the walls alone cannot stop it. Zero wall pressure (the incompressible
+   solvers' default, see BOUNDARIES) pushes no harder. So the end of a step keeps each fluid
+   particle's centre at least d_c = wall_contact dx from every boundary particle's centre. A
+   particle closer than that moves along the wall's normal at its position,
+       n = -sum_b V_b grad W_ib / |sum_b V_b grad W_ib|      (the wall volume fraction's descent),
+   by the least distance s >= 0 that puts it d_c from each wall particle b it touches:
+       s_b = -(x_ib . n) + sqrt((x_ib . n)^2 - |x_ib|^2 + d_c^2),   x_ib = x_i - x_b,
+   and its normal velocity relative to the wall, (v_i - v_b) . n < 0 (v_b of the nearest wall
+   particle), is removed: no restitution, so the contact takes kinetic energy and never adds it.
+   Moving along the wall's normal, not along x_ib, leaves a particle sliding over the bumps of a
+   wall lattice free to slide (along x_ib the contact would brake it at every wall particle it
+   passes). Each fluid particle moves only itself against fixed wall positions, so the result does
+   not depend on the order of particles or threads. A fluid lattice sits 1 dx from its wall
+   lattice, so at rest nothing is touched; over the hollow between the wall particles of a lattice
+   at spacing s a particle stays sqrt(d_c^2 - (D - 1) s^2/4) above their layer, which the default
+   d_c = (0.02 + sqrt(D)/2) dx keeps just over the wall's face (0.53 dx for s = dx, in 2D and
+   3D; a smaller d_c let 3D dam breaks spread their thinnest sheets past the face, and a larger
+   one pushed against the fluid that zero wall pressure lets settle closer than 1 dx). No particle
+   passes between wall particles while s < sqrt(2) d_c (3D; s < 2 d_c in 2D). The step's fluid->wall lists
+   reach the kernel support (>= 2 dx) around the particle's start, which covers d_c plus the step's
+   displacement (at most max_displacement dx, checked next). Returns whether the particle moved. */
+static int sph__wall_contact(const sph__ctx* c, size_t i, sph_real dc, sph_real* xi, sph_real* vi) {
+    const int D = c->dim;
+    const size_t k0 = c->fb->begin[i], k1 = k0 + c->fb->count[i];
+    const sph_real dc2 = dc * dc;
+    int pass, moved = 0;
+    for (pass = 0; pass < 2; ++pass) { /* a second pass for a particle pushed onto another wall */
+        sph_real g[3] = {0, 0, 0}, n[3] = {0, 0, 0}, gn = 0, s = 0, vn = 0, r2min = dc2;
+        size_t kk, near = k1;
+        int k;
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t b = c->fb->idx[kk];
+            sph_real d[3] = {0, 0, 0}, r2 = 0, f;
+            sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
+            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+            if (r2 < r2min) { r2min = r2; near = kk; }
+            f = c->bvol[b] * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h);
+            for (k = 0; k < D; ++k) g[k] -= f * d[k];
+        }
+        if (near == k1) break; /* nothing within d_c */
+        for (k = 0; k < D; ++k) gn += g[k] * g[k];
+        if (gn > 0) {
+            gn = 1 / sph__sqrt(gn);
+            for (k = 0; k < D; ++k) n[k] = g[k] * gn;
+        } else { /* a symmetric spot (inside a thin wall): away from the nearest wall particle */
+            sph_real d[3] = {0, 0, 0}, r;
+            sph__delta_vec(c, xi, c->bx + c->fb->idx[near] * (size_t)D, d, D);
+            r = sph__sqrt(r2min);
+            if (!(r > 0)) break; /* on a wall particle's centre: no direction (check_walls) */
+            for (k = 0; k < D; ++k) n[k] = d[k] / r;
+        }
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t b = c->fb->idx[kk];
+            sph_real d[3] = {0, 0, 0}, r2 = 0, dn = 0, sb;
+            sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
+            for (k = 0; k < D; ++k) { r2 += d[k] * d[k]; dn += d[k] * n[k]; }
+            if (!(r2 < dc2)) continue;
+            sb = -dn + sph__sqrt(dn * dn - r2 + dc2); /* real: dc2 > r2 */
+            if (sb > s) s = sb;
+        }
+        for (k = 0; k < D; ++k) {
+            xi[k] += s * n[k];
+            vn += (vi[k] - c->bv[c->fb->idx[near] * (size_t)D + (size_t)k]) * n[k];
+        }
+        if (vn < 0)
+            for (k = 0; k < D; ++k) vi[k] -= vn * n[k];
+        moved = 1;
+    }
+    return moved;
+}
+
+/* The energy check of the incompressible solvers (PCISPH, IISPH, DFSPH). Without gravity, force
+   callback or moving walls nothing does work on their fluid but its pressure, which gives back no
+   more than the compression it stores, and viscosity, which only takes; at their compression
+   (0.1 %) the stored energy is tiny and only motion makes more of it. So once the forcing stops,
+   a kinetic energy that climbs above the least it has had since by more than half the largest
+   (or, for a fluid started compressed, by more than twice the energy that compression stored at
+   the first unforced step, sum_i p_i V_i max(rho_i/rho0 - 1, 0); and a floor of 1e-4 spacings
+   per step in speed) is the walls or the solver doing work: the step fails with
+   SPH_ERR_UNSTABLE. Measured: the original PCISPH with extrapolated wall pressure in a closed
+   vortex box climbs from 5 J to 490 J within 0.4 s below the speed bound (tests/
+   test_reliability.c's kinetic_energy_decays); the decaying flows of the tests rise by at most
+   6 % of their start between samples. WCSPH stores real elastic energy (a droplet may rebound)
+   and the compressible step's gas trades internal energy for motion: both are exempt. */
+static sph_status sph__energy_check(sph_world* w, double ke, double wrel) {
+    sph_stats* st = &w->stats;
+    int k, forced = w->def.force != NULL || w->def.boundary_motion != NULL ||
+                    !sph__incompressible(w->priv.solver);
+    for (k = 0; k < w->dim; ++k) forced |= w->def.gravity[k] != 0;
+    if (forced || !(st->dt > 0)) {
+        st->unforced_steps = 0;
+        return SPH_OK;
+    }
+    if (st->unforced_steps > 0) {
+        const double floor_v = 1e-4 * (double)w->dx / st->dt;
+        if (ke - st->ke_low > 0.5 * st->ke_high + 0.5 * sph_world_mass(w) * floor_v * floor_v)
+            return sph__fail(w, SPH_ERR_UNSTABLE, -1,
+                             "step %llu (t = %g s): the kinetic energy rose to %g J without "
+                             "forcing (no gravity, force callback or moving wall), from %g J at "
+                             "least and %g J at most since the forcing stopped: the walls or the "
+                             "solver did work on the fluid",
+                             (unsigned long long)w->steps, w->time, ke, st->ke_low, st->ke_high);
+        if (ke < st->ke_low) st->ke_low = ke;
+        if (ke > st->ke_high) st->ke_high = ke;
+    } else {
+        st->ke_low = ke;
+        st->ke_high = ke > 4 * wrel ? ke : 4 * wrel;
+    }
+    ++st->unforced_steps;
+    return SPH_OK;
+}
 
 static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph_real* acc,
                                       sph_real kv, sph_real kr, sph_real kx, int final) {
@@ -4555,6 +4695,8 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                  dt2 = w->stats.dt * w->stats.dt;
     const int walls = final && w->def.check_walls && c->has_b && w->nb > 0 &&
                       w->def.boundary_volume == SPH_BVOL_GIVEN && w->priv.wall_fraction_max > 0;
+    /* the contact distance [m] (sph__wall_contact), at the step's final drift */
+    const sph_real dc = final && kx != 0 && c->has_b && w->nb > 0 ? w->def.wall_contact * w->dx : 0;
     sph__idx blk;
     size_t q;
     int k;
@@ -4615,6 +4757,8 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 }
             }
             if (!final) continue;
+            if (dc > 0 && c->fb->count[i] > 0 && sph__wall_contact(c, i, dc, xi, vi))
+                r[SPH__RED_CONTACT] += 1;
             mi = (double)(w->m ? w->m[i] : w->mass);
             for (kk = 0; kk < D; ++kk) {
                 v2 += (double)vi[kk] * (double)vi[kk];
@@ -4642,6 +4786,8 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                      sph__wall_fraction(c, xi, i, w->priv.lattice_sum) > w->priv.wall_fraction_max)
                 bad = SPH__BAD_WALL;
             r[SPH__RED_KE] += 0.5 * mi * v2;
+            if (err > 0 && w->p && w->rho[i] > 0)
+                r[SPH__RED_WREL] += (double)w->p[i] * mi / (double)w->rho[i] * err;
             r[SPH__RED_ERRSUM] += fabs(err);
             if (err > 0) r[SPH__RED_COMP] += err;
             if (fabs(err) > r[SPH__RED_ERRMAX]) r[SPH__RED_ERRMAX] = fabs(err);
@@ -4667,6 +4813,8 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
         if (r[SPH__RED_V2MAX] > red[SPH__RED_V2MAX]) red[SPH__RED_V2MAX] = r[SPH__RED_V2MAX];
         if (r[SPH__RED_A2MAX] > red[SPH__RED_A2MAX]) red[SPH__RED_A2MAX] = r[SPH__RED_A2MAX];
         red[SPH__RED_OUT] += r[SPH__RED_OUT];
+        red[SPH__RED_CONTACT] += r[SPH__RED_CONTACT];
+        red[SPH__RED_WREL] += r[SPH__RED_WREL];
         if (red[SPH__RED_BAD] < 0 && r[SPH__RED_BAD] >= 0) {
             red[SPH__RED_BAD] = r[SPH__RED_BAD];
             red[SPH__RED_KIND] = r[SPH__RED_KIND];
@@ -4679,6 +4827,11 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
     w->stats.v_max = sqrt(red[SPH__RED_V2MAX]);
     w->stats.a_max = sqrt(red[SPH__RED_A2MAX]);
     w->stats.n_outside = (size_t)red[SPH__RED_OUT];
+    w->stats.contacts = (size_t)red[SPH__RED_CONTACT];
+    if (red[SPH__RED_BAD] < 0) {
+        const sph_status s = sph__energy_check(w, red[SPH__RED_KE], red[SPH__RED_WREL]);
+        if (s != SPH_OK) return s;
+    }
     if (red[SPH__RED_BAD] >= 0) {
         const size_t i = (size_t)red[SPH__RED_BAD];
         const int kind = (int)red[SPH__RED_KIND];

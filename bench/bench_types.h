@@ -80,7 +80,7 @@ typedef struct tts_result {
     int frames;            /* frames completed                                                  */
     int status;            /* sph_status of the call that failed (0: none), -1: scene not built */
     int capped;            /* stopped by --max-wall                                             */
-    char error[256];       /* w.error of the failed call                                        */
+    char error[SPH_ERROR_SIZE]; /* w.error of the failed call                                  */
 } tts_result;
 
 static double bench_now(void) {

@@ -282,7 +282,7 @@ static void test_lifting_piston(void) {
     sph_phase water;
     sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)Wd, (sph_real)H}, whi[2] = {(sph_real)Wd, 1.2};
     sph_real* px;
-    double load_acc = 0, load_const = 0, cm0 = 0, drift = 0, comp = 0;
+    double load_acc = 0, load_const = 0, cm0 = 0, drift = 0, comp = 0, solve = 0;
     size_t i, n = 0;
     int k, n_acc = 0, n_const = 0;
     lp.U = 0.5;
@@ -313,6 +313,7 @@ static void test_lifting_piston(void) {
         size_t b, nb = 0;
         if (th_step(&w, (sph_real)dt) != SPH_OK) { CHECK_MSG(0, "piston: %s", w.error); break; }
         comp = fmax(comp, w.stats.compression_avg);
+        solve = fmax(solve, w.stats.solver_error);
         piston_kinematics(&lp, t0, &y, &v, &a);
         for (b = 0; b < w.nb; ++b) {
             const double bx = (double)w.b_x[2 * b], by = (double)w.b_x[2 * b + 1] - y;
@@ -337,7 +338,12 @@ static void test_lifting_piston(void) {
     CHECK_NEAR(load_acc, 1, 0.03);
     CHECK_NEAR(load_const, 1, 0.03);
     CHECK_LT(drift, 0.2 * dx);
-    CHECK_LE(comp, 0.00105); /* the solver's 0.1 % on predicted compression, measured after the move */
+    /* the solver's 0.1 % on predicted compression; measured after the move it is 0.102 %, and
+       0.111 % at the steps where the wall contact (def.wall_contact) moves the two particles in
+       the piston's corners back out after the solve (measured; 0.0001 of the mean from 2 of 200
+       particles) */
+    CHECK_LE(solve, 0.001 * (1 + 1e-9));
+    CHECK_LE(comp, 0.0012);
     sph_world_free(&w);
 }
 
