@@ -373,6 +373,147 @@ static void test_kinetic_energy_decays(void) {
     vortex_box(3, SPH_BP_MIRROR, 3);
 }
 
+/* ---- wall contact and the energy check ---------------------------------------------------- */
+
+/* A sheet one particle thick (16 x 16 in 3D, 16 in 2D, spacing dx = 0.02 m) falls 1 dx onto a
+   floor the host placed itself (sph_add_boundary: three layers at spacing dx, the wall's face at
+   y = 0, reaching 8 dx beyond the sheet), IISPH with the defaults through sph_advance for 0.3 s.
+   A lone layer of fluid reaches rho0 only once the wall supplies most of its volume, so the
+   density constraint lets it sink onto and past the wall's first layer; the wall contact
+   (def.wall_contact) keeps every centre on the fluid side of the face. Asserted: with the
+   default nothing goes below the face, the mass is exact and the mechanical energy (kinetic plus
+   potential) ends below its start; with the contact off the sheet sinks past the face (or the
+   run reports a particle inside the wall), which shows what the contact holds. */
+static double sheet_drop(int dim, sph_real contact, sph_status* status, size_t* contacts,
+                         double* e0, double* e1) {
+    const double dx = 0.02;
+    const int N = 16, M = 8, ND = dim == 3 ? N : 1, MD = dim == 3 ? M : 0;
+    sph_world_def def = sph_world_def_default(dim);
+    sph_world w;
+    sph_phase water;
+    sph_real *xb, *xf;
+    size_t nb = 0, nf = 0, i;
+    double ymin = 1e9;
+    int a, b, l, k;
+    def.solver = SPH_SOLVER_IISPH;
+    def.spacing = (sph_real)dx;
+    def.wall_contact = contact < 0 ? def.wall_contact : contact;
+    memset(&water, 0, sizeof water);
+    water.rest_density = 1000;
+    *status = sph_world_init(&w, &def);
+    CHECK_EQ_INT(*status, SPH_OK);
+    CHECK(sph_world_add_phase(&w, &water) == 0);
+    xb = (sph_real*)malloc(sizeof(sph_real) * 3 * 3 * (size_t)(N + 2 * M) * (size_t)(N + 2 * M));
+    xf = (sph_real*)malloc(sizeof(sph_real) * 3 * (size_t)N * (size_t)N);
+    for (l = 0; l < 3; ++l)
+        for (a = -M; a < N + M; ++a)
+            for (b = -MD; b < ND + MD; ++b) {
+                sph_real* q = xb + nb++ * (size_t)dim;
+                q[0] = (sph_real)((a + 0.5) * dx);
+                q[1] = (sph_real)(-(l + 0.5) * dx);
+                if (dim == 3) q[2] = (sph_real)((b + 0.5) * dx);
+            }
+    for (a = 0; a < N; ++a)
+        for (b = 0; b < ND; ++b) {
+            sph_real* q = xf + nf++ * (size_t)dim;
+            q[0] = (sph_real)((a + 0.5) * dx);
+            q[1] = (sph_real)(1.5 * dx);
+            if (dim == 3) q[2] = (sph_real)((b + 0.5) * dx);
+        }
+    CHECK_EQ_INT(sph_add_boundary(&w, nb, xb, NULL, 0), SPH_OK);
+    CHECK_EQ_INT(sph_add_fluid(&w, 0, nf, xf, NULL), SPH_OK);
+    free(xb);
+    free(xf);
+    *e0 = *e1 = 0;
+    for (i = 0; i < w.n; ++i) *e0 += (double)w.mass * 9.81 * (double)w.x[i * (size_t)dim + 1];
+    *contacts = 0;
+    *status = SPH_OK;
+    while (w.time < 0.3 - 1e-9 && *status == SPH_OK) {
+        *status = sph_advance(&w, (sph_real)0.01);
+        if (w.stats.contacts > *contacts) *contacts = w.stats.contacts;
+        for (i = 0; i < w.n; ++i) ymin = fmin(ymin, (double)w.x[i * (size_t)dim + 1]);
+    }
+    for (i = 0; i < w.n; ++i) {
+        double v2 = 0;
+        for (k = 0; k < dim; ++k) v2 += (double)w.v[i * (size_t)dim + k] * (double)w.v[i * (size_t)dim + k];
+        *e1 += (double)w.mass * (9.81 * (double)w.x[i * (size_t)dim + 1] + 0.5 * v2);
+    }
+    CHECK_NEAR(sph_world_mass(&w), (double)nf * (double)w.mass, 1e-12 * sph_world_mass(&w));
+    sph_world_free(&w);
+    return ymin;
+}
+
+static void test_wall_contact_sheet(void) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        sph_status s_on, s_off;
+        size_t c_on, c_off;
+        double e0, e1, f0, f1;
+        const double on = sheet_drop(dim, -1, &s_on, &c_on, &e0, &e1);
+        const double off = sheet_drop(dim, 0, &s_off, &c_off, &f0, &f1);
+        TH_NOTE("%dD sheet on a host-placed floor, IISPH defaults, 0.3 s: lowest centre %+.3f dx "
+                "from the wall's face with the contact (up to %zu particles moved in a step; "
+                "energy %.4g -> %.4g J), %+.3f dx without it%s", dim, on / 0.02, c_on, e0, e1,
+                off / 0.02, s_off != SPH_OK ? " (the run reported a failure)" : "");
+        CHECK_EQ_INT(s_on, SPH_OK);
+        CHECK_LT(0, on);
+        CHECK_LT(0, (double)c_on);
+        CHECK_LT(e1, e0);
+        CHECK(off < 0 || s_off != SPH_OK);
+    }
+}
+
+/* The energy check (sph__energy_check) must not fire on an unforced fluid that is only giving
+   back its own compression, nor when the host changes the velocities between calls: a 2D box
+   filled completely with a lattice jittered by up to 0.1 dx (so compressed here and there), no
+   gravity, at rest, PCISPH enhanced, IISPH and DFSPH through sph_advance for 0.2 s; at 0.1 s the
+   host sets a vortex of 0.3 m/s. Every call returns SPH_OK. (That it does fire is
+   kinetic_energy_decays' original PCISPH with extrapolated walls.) */
+static void test_energy_check_quiet(void) {
+    int which;
+    for (which = 1; which <= 4; ++which) {
+        sph_world_def def = which == 4 ? sph_world_def_default(2) : solver_def(which == 2 ? 3 : 1);
+        sph_world w;
+        sph_phase fluid;
+        sph_real lo[2] = {0, 0}, hi[2] = {0.4, 0.4};
+        sph_status s = SPH_OK;
+        unsigned seed = 12345u;
+        size_t i;
+        if (which == 3) continue; /* solver_def(3) is IISPH, run as which == 2 */
+        if (which == 4) def.solver = SPH_SOLVER_DFSPH;
+        memset(&fluid, 0, sizeof fluid);
+        fluid.rest_density = 1000;
+        fluid.viscosity = (sph_real)1e-3;
+        fluid.sound_speed = 10; /* the speed bound (5 m/s): the automatic c0 would follow the
+                                   first motion it sees, 10 times the jitter's release speed */
+        def.spacing = (sph_real)0.02;
+        def.gravity[1] = 0;
+        CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
+        CHECK(sph_world_add_phase(&w, &fluid) == 0);
+        CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
+        CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 0, 0), SPH_OK);
+        for (i = 0; i < 2 * w.n; ++i) {
+            seed = seed * 1664525u + 1013904223u;
+            w.x[i] += (sph_real)(0.02 * 0.1 * (((seed >> 8) & 0xffff) / 32768.0 - 1));
+        }
+        while (w.time < 0.2 - 1e-9 && s == SPH_OK) {
+            s = sph_advance(&w, (sph_real)0.02);
+            if (fabs(w.time - 0.1) < 1e-9) /* the vortex of kinetic_energy_decays, 0.3 m/s */
+                for (i = 0; i < w.n; ++i) {
+                    const double P = 3.14159265358979, x = (double)w.x[2 * i] / 0.4,
+                                 y = (double)w.x[2 * i + 1] / 0.4;
+                    w.v[2 * i] = (sph_real)(0.3 * sin(P * x) * sin(P * x) * sin(2 * P * y));
+                    w.v[2 * i + 1] = (sph_real)(-0.3 * sin(2 * P * x) * sin(P * y) * sin(P * y));
+                }
+        }
+        TH_NOTE("%s: unforced jittered box, host-set vortex at 0.1 s: %s at t = %.2f s, "
+                "kinetic energy %.3g J", which == 4 ? "DFSPH" : solver_name(&def),
+                s == SPH_OK ? "ok" : w.error, w.time, w.stats.kinetic_energy);
+        CHECK_EQ_INT(s, SPH_OK);
+        sph_world_free(&w);
+    }
+}
+
 /* ---- determinism ------------------------------------------------------------------------- */
 
 /* Golden hashes of test_golden_hash's runs (x86-64, SSE2 arithmetic, no FMA contraction). */
@@ -492,6 +633,8 @@ const th_test tests_reliability[] = {
     {"reliability/stirrer_confined", test_stirrer_confined},
     {"reliability/momentum_periodic", test_momentum_periodic},
     {"reliability/kinetic_energy_decays", test_kinetic_energy_decays},
+    {"reliability/wall_contact_sheet", test_wall_contact_sheet},
+    {"reliability/energy_check_quiet", test_energy_check_quiet},
     {"reliability/golden_hash_threads", test_golden_hash},
     {0, 0},
 };
