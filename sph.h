@@ -902,7 +902,8 @@ typedef struct sph_world_def {
                                   every boundary particle's centre [-]: a step that ends closer
                                   moves it back out along the line between them and removes its
                                   velocity into that particle (relative to the wall's), a
-                                  free-slip, inelastic contact (sph__wall_contact). Default
+                                  free-slip, inelastic contact (sph__wall_contact; every step
+                                  but SPH_SCHEME_SECOND_ORDER's, not yet). Default
                                   0.02 + sqrt(dim)/2 (0.73 in 2D, 0.89 in 3D: a particle over the
                                   hollow between the particles of a wall lattice at dx keeps its
                                   centre on the fluid side of the wall's face; a fluid lattice
@@ -4613,9 +4614,10 @@ static sph_real sph__wall_fraction(const sph__ctx* c, const sph_real* xi, size_t
    d_c = (0.02 + sqrt(D)/2) dx keeps just over the wall's face (0.53 dx for s = dx, in 2D and
    3D; a smaller d_c let 3D dam breaks spread their thinnest sheets past the face, and a larger
    one pushed against the fluid that zero wall pressure lets settle closer than 1 dx). No particle
-   passes between wall particles while s < sqrt(2) d_c (3D; s < 2 d_c in 2D). The step's fluid->wall lists
-   reach the kernel support (>= 2 dx) around the particle's start, which covers d_c plus the step's
-   displacement (at most max_displacement dx, checked next). Returns whether the particle moved. */
+   passes between wall particles while s < sqrt(2) d_c (3D; s < 2 d_c in 2D). The step's
+   fluid->wall lists reach the kernel support (>= 2 dx) around the particle's start, which covers
+   d_c plus the step's displacement (at most max_displacement dx, checked next). Returns whether
+   the particle moved. */
 static int sph__wall_contact(const sph__ctx* c, size_t i, sph_real dc, sph_real* xi, sph_real* vi) {
     const int D = c->dim;
     const size_t k0 = c->fb->begin[i], k1 = k0 + c->fb->count[i];

@@ -435,7 +435,10 @@ static double sheet_drop(int dim, sph_real contact, sph_status* status, size_t* 
     }
     for (i = 0; i < w.n; ++i) {
         double v2 = 0;
-        for (k = 0; k < dim; ++k) v2 += (double)w.v[i * (size_t)dim + k] * (double)w.v[i * (size_t)dim + k];
+        for (k = 0; k < dim; ++k) {
+            const double vk = (double)w.v[i * (size_t)dim + (size_t)k];
+            v2 += vk * vk;
+        }
         *e1 += (double)w.mass * (9.81 * (double)w.x[i * (size_t)dim + 1] + 0.5 * v2);
     }
     CHECK_NEAR(sph_world_mass(&w), (double)nf * (double)w.mass, 1e-12 * sph_world_mass(&w));
