@@ -7045,11 +7045,24 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
         }
         {
             char msg[SPH_ERROR_SIZE];
-            const long idx = w->error_index;
+            long idx = w->error_index;
             const double factor = 0.5 * fmin(w->stats.dt_factor, dt / dt_stable);
+            /* the failing step may have re-sorted the particles: keep the named one by its id,
+               to find it in the restored order (fluid or boundary, as the message says) */
+            const int boundary = strstr(w->error, "boundary particle") != NULL &&
+                                 strstr(w->error, "fluid particle") == NULL;
+            const size_t count = boundary ? w->nb : w->n;
+            const uint32_t* ids = boundary ? w->b_id : w->id;
+            const uint32_t id = idx >= 0 && (size_t)idx < count ? ids[idx] : 0;
             double t;
             memcpy(msg, w->error, sizeof msg);
             sph__snapshot_restore(w, 0);
+            if (idx >= 0 && (size_t)idx < count) {
+                const uint32_t* now = boundary ? w->b_id : w->id;
+                size_t q;
+                for (q = 0; q < count && now[q] != id; ++q) {}
+                idx = q < count ? (long)q : -1;
+            }
             w->stats.substeps = substeps;
             w->stats.retries = retries;
             w->stats.dt_min = dt_min;
