@@ -4627,16 +4627,21 @@ static int sph__wall_contact(const sph__ctx* c, size_t i, sph_real dc, sph_real*
         sph_real g[3] = {0, 0, 0}, n[3] = {0, 0, 0}, gn = 0, s = 0, vn = 0, r2min = dc2;
         size_t kk, near = k1;
         int k;
+        for (kk = k0; kk < k1; ++kk) { /* the nearest wall particle within d_c, if any */
+            sph_real d[3] = {0, 0, 0}, r2 = 0;
+            sph__delta_vec(c, xi, c->bx + c->fb->idx[kk] * (size_t)D, d, D);
+            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+            if (r2 < r2min) { r2min = r2; near = kk; }
+        }
+        if (near == k1) break; /* nothing within d_c: no kernel gradient needed */
         for (kk = k0; kk < k1; ++kk) {
             const size_t b = c->fb->idx[kk];
             sph_real d[3] = {0, 0, 0}, r2 = 0, f;
             sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
             for (k = 0; k < D; ++k) r2 += d[k] * d[k];
-            if (r2 < r2min) { r2min = r2; near = kk; }
             f = c->bvol[b] * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h);
             for (k = 0; k < D; ++k) g[k] -= f * d[k];
         }
-        if (near == k1) break; /* nothing within d_c */
         for (k = 0; k < D; ++k) gn += g[k] * g[k];
         if (gn > 0) {
             gn = 1 / sph__sqrt(gn);

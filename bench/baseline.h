@@ -23,6 +23,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* OpenMP loops only when built with it (no unknown-pragma warnings without) */
+#if defined(_OPENMP)
+#define BASE_PRAGMA(x) _Pragma(#x)
+#else
+#define BASE_PRAGMA(x)
+#endif
+
 #define BASE_MAXNB 128 /* list row capacity: 3D at h = 1.3 dx has ~76 neighbours */
 
 typedef struct base_grid {
@@ -214,7 +221,7 @@ static void base__lists(base_world* b, const base_grid* g, const sph_real* y, co
     const sph_real R2 = b->R * b->R;
     long i;
     int overflow = 0;
-#pragma omp parallel for schedule(static) reduction(| : overflow)
+BASE_PRAGMA(omp parallel for schedule(static) reduction(| : overflow))
     for (i = 0; i < (long)nq; ++i) {
         const sph_real* xi = xq + (size_t)i * (size_t)D;
         int c[3] = {0, 0, 0}, o[3], k;
@@ -284,7 +291,7 @@ static int base_step(base_world* b, sph_real dt) {
     t0 = t1;
     if (b->overflow) return 0;
         /* pressure (Tait, gamma = 7) and body acceleration */
-#pragma omp parallel for schedule(static)
+BASE_PRAGMA(omp parallel for schedule(static))
     for (i = 0; i < (long)n; ++i) {
         const sph_real t = b->rho[i] / b->rho0;
         int k;
@@ -293,7 +300,7 @@ static int base_step(base_world* b, sph_real dt) {
             b->a[(size_t)i * (size_t)D + (size_t)k] = b->g[k];
     }
     /* wall pressure: Adami et al. 2012 eq. 27 (static walls), wall density from eq. 28 */
-#pragma omp parallel for schedule(static)
+BASE_PRAGMA(omp parallel for schedule(static))
     for (i = 0; i < (long)nb; ++i) {
         sph_real sw = 0, swp = 0, sgx = 0;
         uint32_t q;
@@ -319,7 +326,7 @@ static int base_step(base_world* b, sph_real dt) {
     b->t_other += t1 - t0;
     t0 = t1;
     /* forces: pressure (symmetric form) and artificial viscosity; walls without viscosity */
-#pragma omp parallel for schedule(static)
+BASE_PRAGMA(omp parallel for schedule(static))
     for (i = 0; i < (long)n; ++i) {
         const sph_real* xi = b->x + (size_t)i * (size_t)D;
         const sph_real* vi = b->v + (size_t)i * (size_t)D;
@@ -362,12 +369,12 @@ static int base_step(base_world* b, sph_real dt) {
     t1 = bench_now();
     b->t_forces += t1 - t0;
     t0 = t1;
-#pragma omp parallel for schedule(static)
+BASE_PRAGMA(omp parallel for schedule(static))
     for (i = 0; i < (long)(n * (size_t)D); ++i)
         b->v[i] += dt * b->a[i]; /* kick */
         /* density rate: continuity with the new velocities, plus delta-SPH (Molteni & Colagrossi)
          */
-#pragma omp parallel for schedule(static)
+BASE_PRAGMA(omp parallel for schedule(static))
     for (i = 0; i < (long)n; ++i) {
         const sph_real* xi = b->x + (size_t)i * (size_t)D;
         const sph_real* vi = b->v + (size_t)i * (size_t)D;
@@ -405,7 +412,7 @@ static int base_step(base_world* b, sph_real dt) {
     t1 = bench_now();
     b->t_density += t1 - t0;
     t0 = t1;
-#pragma omp parallel for schedule(static)
+BASE_PRAGMA(omp parallel for schedule(static))
     for (i = 0; i < (long)n; ++i) { /* density and drift */
         int k;
         b->rho[i] += dt * b->drho[i];
