@@ -374,21 +374,21 @@ static void test_dt_sweep(void) {
 
 /* ---- determinism --------------------------------------------------------------------------- */
 
-static void test_iisph_determinism(void) {
+/* The dam break of scene_dam_break (a = 0.1 m at res particles per a) with def, `steps` steps of
+   dt on 1 and on 2 threads: bitwise the same state and iteration count. */
+static void iisph_same_on_1_and_2_threads(sph_world_def def, int res, int steps, double dt) {
 #ifndef _OPENMP
+    (void)def; (void)res; (void)steps; (void)dt;
     TH_SKIP("built without OpenMP");
 #else
     sph_world a, b;
     int t, s;
+    def.solver = SPH_SOLVER_IISPH;
     for (t = 1; t <= 2; ++t) {
         sph_world* w = t == 1 ? &a : &b;
-        sph_world_def def = sph_world_def_default(2);
-        def.boundary_pressure = SPH_BP_EXTRAPOLATE; /* the wall scheme this test was written for (the
-                                                   default before SPH_BP_AUTO) */
         omp_set_num_threads(t);
-        def.solver = SPH_SOLVER_IISPH;
-        CHECK_EQ_INT(scene_dam_break(w, def, 0.1, 24, NULL), SPH_OK);
-        for (s = 0; s < 60; ++s) CHECK_EQ_INT(th_step(w, 1e-3), SPH_OK);
+        CHECK_EQ_INT(scene_dam_break(w, def, 0.1, res, NULL), SPH_OK);
+        for (s = 0; s < steps; ++s) CHECK_EQ_INT(th_step(w, (sph_real)dt), SPH_OK);
     }
     CHECK(a.n == b.n && memcmp(a.x, b.x, a.n * 2 * sizeof(sph_real)) == 0);
     CHECK(memcmp(a.v, b.v, a.n * 2 * sizeof(sph_real)) == 0);
@@ -398,6 +398,13 @@ static void test_iisph_determinism(void) {
     sph_world_free(&b);
     omp_set_num_threads(omp_get_num_procs());
 #endif
+}
+
+static void test_iisph_determinism(void) {
+    sph_world_def def = sph_world_def_default(2);
+    def.boundary_pressure = SPH_BP_EXTRAPOLATE; /* the wall scheme this test was written for (the
+                                                   default before SPH_BP_AUTO) */
+    iisph_same_on_1_and_2_threads(def, 24, 60, 1e-3);
 }
 
 /* A step whose solve ends with a particle still predicted beyond def.max_compression fails at
@@ -553,29 +560,9 @@ static void test_cg_tank_at_rest(void) {
 /* Bitwise the same on 1 and 2 threads (a dam break above the 2048 particles where the parallel
    loops start). */
 static void test_cg_determinism(void) {
-#ifndef _OPENMP
-    TH_SKIP("built without OpenMP");
-#else
-    sph_world a, b;
-    int t, s;
-    for (t = 1; t <= 2; ++t) {
-        sph_world* w = t == 1 ? &a : &b;
-        sph_world_def def = sph_world_def_default(2);
-        omp_set_num_threads(t);
-        def.solver = SPH_SOLVER_IISPH;
-        def.pressure_solve = SPH_PSOLVE_CG;
-        CHECK_EQ_INT(scene_dam_break(w, def, 0.1, 48, NULL), SPH_OK);
-        CHECK(w->n > 2048);
-        for (s = 0; s < 20; ++s) CHECK_EQ_INT(th_step(w, 1e-3), SPH_OK);
-    }
-    CHECK(a.n == b.n && memcmp(a.x, b.x, a.n * 2 * sizeof(sph_real)) == 0);
-    CHECK(memcmp(a.v, b.v, a.n * 2 * sizeof(sph_real)) == 0);
-    CHECK(memcmp(a.p, b.p, a.n * sizeof(sph_real)) == 0);
-    CHECK(a.stats.iterations == b.stats.iterations);
-    sph_world_free(&a);
-    sph_world_free(&b);
-    omp_set_num_threads(omp_get_num_procs());
-#endif
+    sph_world_def def = sph_world_def_default(2);
+    def.pressure_solve = SPH_PSOLVE_CG;
+    iisph_same_on_1_and_2_threads(def, 48, 20, 1e-3);
 }
 
 const th_test tests_iisph[] = {
