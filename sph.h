@@ -1267,7 +1267,9 @@ SPHDEF void sph_world_def_pcisph(sph_world_def* def, int enhanced);
 /* One predictive-corrective step of dt [s]: pressures are corrected until the predicted density
    error is below def.tolerance on average (and def.tolerance_max at most, if set), after
    def.min_iterations and at most def.max_iterations. w->stats.iterations and .solver_error
-   report the solve. */
+   report the solve. A fluid without a free surface (a closed box it fills) is corrected with
+   zero wall pressure whatever def.boundary_pressure says (w.b_p is 0 in such a step): walls that
+   copy the fluid's pressure make its pressure force no constraint force there. */
 SPHDEF sph_status sph_step_pcisph(sph_world* w, sph_real dt);
 
 /* ============================================================================================== */
@@ -4992,7 +4994,9 @@ static sph_real sph__standing_keep(const sph_world* w) {
    the source is removed, and the solve controls the density differences, which a fixed volume of
    fluid can satisfy. The uniform part, a summation-density bias of the disordered lattice, is
    left alone (in a 2D box with a vortex it reaches about 4 % by 0.4 s). With ZERO walls the
-   wall pressure anchors the level and nothing is done. Deterministic: one serial pass. */
+   wall pressure anchors the level and nothing is done. Deterministic: one serial pass. IISPH and
+   DFSPH project; PCISPH instead runs an enclosed fluid's correction with zero wall pressure, the
+   density constraint's own wall term (derived in sph__step_pcisph), which has no null mode. */
 static int sph__enclosed(const sph_world* w) {
     const double D = (double)w->dim;
     const double anchor = fmax(1.0, 0.2 * pow((double)w->n, (D - 1) / D));
@@ -5905,9 +5909,8 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
        drift for summation), so the gain doubles */
     const double S = (summation ? (double)w->priv.lattice_sum : 1.0) * (verlet ? 2.0 : 1.0);
     double t0 = sph__now(), tstart = t0, err = 0, errmax = 0, proto[SPH_MAX_PHASES];
-    sph_real keep, shift = 0;
+    sph_real keep;
     double errmax_min = 0;
-    int enclosed;
     uint64_t sorts;
     sph__ctx c;
     sph_status s;
@@ -5983,7 +5986,45 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
     }
     memset(w->priv.ap, 0, nD * sizeof(sph_real));
     keep = sph__standing_keep(w);
-    enclosed = sph__enclosed(w); /* from the density at x^n */
+    if (sph__enclosed(w)) { /* from the density at x^n */
+        /* An enclosed fluid with walls that copy its pressure (extrapolated, mirrored): the
+           correction runs with the wall term of the density constraint instead, p_b = 0, and
+           needs no compatibility projection (sph__enclosed's, which IISPH and DFSPH keep).
+           The constraint is C_i = rho*_i with the continuity rate (Enhanced PCISPH 2018 eq. 3.2)
+               R_i = sum_j m_j v_ij . grad W_ij + sum_b psi_b v_ib . grad W_ib,  psi_b = rho0 V_b,
+           whose pressure force as a constraint force (Koschier et al. 2019 tutorial: the
+           pressure force is built from the gradients of the density constraints), here in the
+           multiphase form (eq. 12),
+               a_i = -sum_j m_j (p_i + p_j) / (rho_i rho_j) grad W_ij
+                     - sum_b psi_b p_i / (rho_i rho_b) grad W_ib,
+           carries the particle's own pressure at the wall: the wall term of zero wall pressure
+           (Akinci et al. 2012). Band et al. 2018 ("Pressure boundaries for implicit incompressible
+           SPH") go further and solve for the boundary samples' pressures in an extended pressure
+           equation instead of copying the fluid's; not done here. Its power is
+           P = sum_i m_i v_i . a_i = -sum_i p_i m_i / (rho_i rho_*) R_i (rho_* the neighbour's
+           density), so a pressure that holds the constraint does no work, and the per-particle gain
+           (sph__pcisph_denominator: walls in the first product only) is this constraint's own.
+           The extrapolated wall pressure p_b = sum_f p_f W_bf / sum_f W_bf (Adami et al. 2012 eq.
+           27) adds -sum_b psi_b p_b / (rho_i rho_b) grad W_ib, no derivative of any C_j: its
+           constant mode cancels the fluid's gradient exactly (the pure-Neumann problem), while
+           the rate's sum over particles, sum_i v_i . (2 m G_i + B_i) with G_i = sum_j grad W_ij and
+           B_i = sum_b psi_b grad W_ib (m G_i + B_i = 0 in a full neighbourhood), stays m sum_i
+           v_i . G_i for a fluid moving along a wall, so the mean density drifts where no pressure
+           can hold it. Measured in tests/test_scenes.c's vortex boxes with extrapolated walls:
+           the mean of rho - rho0 reached +63 kg/m^3 in 3D by t = 0.2 s (the mean projection
+           hid it from the correction until sph__enclosed's count of thin neighbourhoods turned
+           it off at t = 0.09 s, then the pressure level rose to 1e8 Pa and sph_advance failed),
+           and the mean |rho / rho0 - 1| 4.6 % in 2D by 0.3 s, where the kinetic energy rose
+           by 1.7 % of its start in one frame. With p_b = 0 a uniform pressure pushes the first
+           layer off the walls, the mean density error stays at 0.06-0.26 % (2D) and 0.2-1.6 %
+           (3D), and the kinetic energy only decays. Tried and not kept: keeping p_b and adding
+           its adjoint to the rate (each wall particle's compression rate handed back to the fluid
+           with the Shepard weights it took p_b with)
+           removed half the drift and the 2D rise, not the 3D failure; removing the rate's mean,
+           or fixing the pressure level at min p = 0, made the boxes fail earlier. */
+        c.bp_mode = SPH_BP_ZERO;
+        memset(w->b_p, 0, w->nb * sizeof(sph_real));
+    }
     /* predict and correct */
     for (;;) {
         const size_t nb2 = nblk;
@@ -6006,17 +6047,6 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
             SPH__OMP_FOR(w->n)
             for (i = 0; i < (sph__idx)w->n; ++i) w->rho[i] = w->priv.rho_n[i] + dt * w->drho[i];
         }
-        /* an enclosed fluid: the mean predicted density error, which no pressure can remove (see
-           sph__enclosed), is not corrected; a serial sum, so the same for any thread count */
-        if (enclosed) {
-            double mean = 0;
-            size_t j;
-            for (j = 0; j < w->n; ++j) {
-                const sph_real r0 = c.pc[w->phase[j]].rho0, rn = w->priv.rho_n[j];
-                mean += (double)(w->rho[j] - r0 - keep * (rn > r0 ? rn - r0 : 0));
-            }
-            shift = (sph_real)(mean / (double)w->n);
-        }
         /* correct the pressure; mean and largest predicted compression (fixed-order blocks) */
         SPH__OMP_FOR(w->n)
         for (blk = 0; blk < (sph__idx)nb2; ++blk) {
@@ -6026,7 +6056,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
             size_t j;
             for (j = i0; j < i1; ++j) {
                 const sph_real r0 = c.pc[w->phase[j]].rho0, rn = w->priv.rho_n[j];
-                const sph_real drho = w->rho[j] - r0 - keep * (rn > r0 ? rn - r0 : 0) - shift;
+                const sph_real drho = w->rho[j] - r0 - keep * (rn > r0 ? rn - r0 : 0);
                 const sph_real p = w->p[j] + w->priv.aii[j] * drho;
                 const double comp = drho > 0 ? (double)(drho / r0) : 0.0;
                 w->p[j] = p > 0 ? p : 0;
