@@ -47,6 +47,8 @@ extern const th_test tests_scenes_long[];
 extern const th_test tests_hostile[]; /* hostile input (issue 19) */
 extern const th_test tests_viscous[]; /* viscous accuracy and dissipation (issue 18) */
 extern const th_test tests_viscous_long[];
+extern const th_test tests_layers[]; /* layered columns at rest (issue 18, item 1) */
+extern const th_test tests_layers_long[];
 
 void th_fail(const char* file, int line, const char* fmt, ...);
 void th_note(const char* fmt, ...);
