@@ -269,7 +269,12 @@ int main(void) {
    from sinking until the wall supplies the volume it lacks, i.e. onto and past the wall's first
    layer. So the end of every step keeps each fluid centre at least wall_contact dx (0.73 in 2D,
    0.89 in 3D) from every boundary particle, moving it along the wall's normal and removing its
-   velocity into the wall (free slip, inelastic: it takes energy, never adds it). Measured on
+   velocity into the wall (free slip, inelastic: it takes energy, never adds it). In 3D with zero
+   wall pressure and PCISPH, IISPH or DFSPH that distance is for particles short of neighbours
+   (fewer fluid and wall neighbours than 0.7 of a full lattice's) and ramps down to 0.6 dx for
+   those with 0.85 and more: zero wall pressure rests those rows 0.5-0.65 dx from the wall's
+   first layer, and a contact that fought them kept a 3D tank at rest moving at 0.2 sqrt(g H)
+   (see sph__wall_contact). Measured on
    the 3D dam break at dx 0.05 (./build/bench tts --scene 3d-6k): fluid particles outside the
    container at a frame end, most at once, 390 -> 0 (WCSPH), 904 -> 0 (IISPH), 915 -> 0 (DFSPH);
    a one-particle sheet dropped on a host-placed floor (tests/test_reliability.c) sinks 0.67 dx
@@ -323,7 +328,9 @@ int main(void) {
    particle; an iterative pressure solve that stops at max_iterations above its tolerance returns
    SPH_ERR_NOT_CONVERGED (the step was taken). sph_advance turns both into retries: the failed
    sub-step is undone bit for bit and taken again at half the step (up to 12 times in a row, the
-   pressure solve starting cold), the step grows back by 1.1 per success, at most
+   pressure solve starting cold), the step grows back by 1.1 per success; a sub-step that fails
+   that way may have started from a state an earlier sub-step left beyond repair, so the call is
+   then taken again from its start at a quarter of its first step (twice at most); at most
    def.max_substeps sub-steps a call (SPH_ERR_BUDGET); when it gives up, the world is as before
    the call. Which scenes each solver holds this way is measured in tests/test_scenes.c. The
    library never calls exit or abort on user input and never drops particles: particles leaving
@@ -924,7 +931,12 @@ typedef struct sph_world_def {
                                   moves it back out along the line between them and removes its
                                   velocity into that particle (relative to the wall's), a
                                   free-slip, inelastic contact (sph__wall_contact; every step
-                                  but SPH_SCHEME_SECOND_ORDER's, not yet). Default
+                                  but SPH_SCHEME_SECOND_ORDER's, not yet); in 3D with zero wall
+                                  pressure and PCISPH, IISPH or DFSPH for particles short of
+                                  neighbours (fewer fluid and wall neighbours than 0.7 of a full
+                                  lattice's: splashes, sheets), ramping down to 0.6 for the
+                                  others (0.85 and more), whose resting rows zero wall pressure
+                                  puts nearer the wall than the lattice. Default
                                   0.02 + sqrt(dim)/2 (0.73 in 2D, 0.89 in 3D: a particle over the
                                   hollow between the particles of a wall lattice at dx keeps its
                                   centre on the fluid side of the wall's face; a fluid lattice
@@ -4650,7 +4662,34 @@ static sph_real sph__wall_fraction(const sph__ctx* c, const sph_real* xi, size_t
    passes between wall particles while s < sqrt(2) d_c (3D; s < 2 d_c in 2D). The step's
    fluid->wall lists reach the kernel support (>= 2 dx) around the particle's start, which covers
    d_c plus the step's displacement (at most max_displacement dx, checked next). Returns whether
-   the particle moved. */
+   the particle moved.
+   In 3D with zero wall pressure and an incompressible solver d_c is for particles short of
+   neighbours: one whose fluid and wall neighbours number at least SPH__CONTACT_FULL of a full
+   lattice neighbourhood (the measure sph__enclosed uses) has the wall supply only what a fluid
+   would, so the pressure solve, which holds its density, holds it, and its contact distance is
+   SPH__CONTACT_REST dx (over a wall particle its centre stays 0.1 dx on the fluid side of the
+   wall's face; over the hollow between wall particles it is free to reach the face, where zero
+   wall pressure's resting rows sit, +-0.04 dx); the distance grows linearly to d_c as the count
+   falls to SPH__CONTACT_SHORT of a full set (a switch instead
+   of the ramp moved a particle 0.4 dx in one step whenever its count crossed the line, and its
+   neighbours answered at 0.1-0.14 sqrt(g H)). Why: zero wall pressure's resting state is not the
+   lattice. The wall pushes with p_i alone, so the rows at a wall settle up to 0.35 dx closer to
+   it, 0.5-0.65 dx from the first layer in 3D, and a contact at 0.89 dx fought that at every
+   step: about 200 of the 800 particles of a 3D tank at rest (0.4 m, dx 0.04) were moved each
+   step and the tank kept moving at 0.2-0.25 sqrt(g H) for good; with the ramp it comes to rest
+   (tests/test_scenes.c, tank_3d_settles). In 2D the rows rest at 0.75-0.93 dx, beyond the 2D
+   d_c of 0.73 dx, and the ramp gained nothing but centres up to 0.06 dx past the face at the
+   side walls near the surface, so 2D keeps d_c for every particle. A rule on the height above
+   the wall along n instead of the distance (tried) fought the rows that settle at the face just
+   as well (IISPH 0.12, DFSPH 0.23 sqrt(g H) after 4 s). The splashes and one-particle sheets the contact is for have few
+   fluid neighbours and are still caught (tests/test_reliability.c's wall_contact_sheet; no
+   particle through a wall in tests/test_scenes.c's dam breaks). Extrapolated and mirrored walls
+   hold the fluid at the lattice's 1 dx, where d_c touches nothing, and WCSPH's equation of state
+   holds no density (with zero wall pressure its floor row went through without the contact,
+   tests/test_wcsph.c): there d_c applies to every particle. */
+#define SPH__CONTACT_FULL 0.85
+#define SPH__CONTACT_SHORT 0.7
+#define SPH__CONTACT_REST 0.6
 static int sph__wall_contact(const sph__ctx* c, size_t i, sph_real dc, sph_real* xi, sph_real* vi) {
     const int D = c->dim;
     const size_t k0 = c->fb->begin[i], k1 = k0 + c->fb->count[i];
@@ -4761,8 +4800,12 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                  dt2 = w->stats.dt * w->stats.dt;
     const int walls = final && w->def.check_walls && c->has_b && w->nb > 0 &&
                       w->def.boundary_volume == SPH_BVOL_GIVEN && w->priv.wall_fraction_max > 0;
-    /* the contact distance [m] (sph__wall_contact), at the step's final drift */
+    /* the contact distance [m] (sph__wall_contact), at the step's final drift, and whether it
+       ramps down with the neighbour count (3D, zero wall pressure, incompressible solvers) */
     const sph_real dc = final && kx != 0 && c->has_b && w->nb > 0 ? w->def.wall_contact * w->dx : 0;
+    const int ramp = D == 3 && sph__incompressible(w->priv.solver) &&
+                     c->bp_mode == SPH_BP_ZERO && w->priv.full_count > 0;
+    const sph_real inv_full = ramp ? 1 / (sph_real)w->priv.full_count : 0;
     sph__idx blk;
     size_t q;
     int k;
@@ -4823,8 +4866,18 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 }
             }
             if (!final) continue;
-            if (dc > 0 && c->fb->count[i] > 0 && sph__wall_contact(c, i, dc, xi, vi))
-                r[SPH__RED_CONTACT] += 1;
+            if (dc > 0 && c->fb->count[i] > 0) {
+                sph_real d = dc;
+                if (ramp) { /* from d_c short of neighbours down to 0.6 dx with a full set */
+                    const sph_real d0 = SPH__R(SPH__CONTACT_REST) * w->dx;
+                    const sph_real nf = (sph_real)(c->ff->count[i] + c->fb->count[i]) * inv_full;
+                    sph_real f = (SPH__R(SPH__CONTACT_FULL) - nf) *
+                                 SPH__R(1 / (SPH__CONTACT_FULL - SPH__CONTACT_SHORT));
+                    f = f < 0 ? 0 : f > 1 ? 1 : f;
+                    d = d0 + f * (dc > d0 ? dc - d0 : 0);
+                }
+                if (sph__wall_contact(c, i, d, xi, vi)) r[SPH__RED_CONTACT] += 1;
+            }
             mi = (double)(w->m ? w->m[i] : w->mass);
             for (kk = 0; kk < D; ++kk) {
                 v2 += (double)vi[kk] * (double)vi[kk];
@@ -7194,7 +7247,10 @@ static void sph__snapshot_restore(sph_world* w, int slot) {
      a sub-step that fails with SPH_ERR_UNSTABLE (blow-up, runaway, a particle through a wall or
           moving too far) or SPH_ERR_NOT_CONVERGED is undone bit for bit and retried with half
           the step (dt_factor halves), at most SPH__RETRIES times in a row;
-     after each successful sub-step dt_factor grows by 1.1 back towards 1.
+     after each successful sub-step dt_factor grows by 1.1 back towards 1;
+     a sub-step that still fails (not the call's first) is taken as a sign that an accepted
+          sub-step left a state no step can continue from: the call starts again from its
+          beginning at a quarter of the step it began with, at most twice.
    The factor is kept in the world, so a scene that needs a smaller step than the rule gives
    pays for the failed attempts once, not every frame. Any failure that remains, and every other
    error (out of memory, a bad callback value), puts the world back to the state before the
@@ -7203,8 +7259,8 @@ static void sph__snapshot_restore(sph_world* w, int slot) {
 
 SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
     double t_end;
-    int substeps = 0, retries = 0, in_row = 0;
-    double dt_min = 0, iterations = 0;
+    int substeps = 0, retries = 0, in_row = 0, restarts = 0, first = 1;
+    double dt_min = 0, iterations = 0, factor0;
     sph_status s;
     if (!w) return SPH_ERR_ARG;
     if (!sph__finite((double)duration) || duration < 0)
@@ -7213,6 +7269,7 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
     t_end = w->time + (double)duration;
     if (!(t_end > w->time)) return SPH_OK; /* nothing to do at the resolution of w.time */
     if (!(w->stats.dt_factor > 0) || w->stats.dt_factor > 1) w->stats.dt_factor = 1;
+    factor0 = w->stats.dt_factor;
     s = sph__snapshot_take(w, 0);
     if (s != SPH_OK) return s;
     while (w->time < t_end) {
@@ -7259,7 +7316,7 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
                              "sph_advance: the step %g s is below the resolution of the time %g s "
                              "(or of sph_real); the world is as before the call", dt, t);
         }
-        if (substeps > 0) { /* the state of this sub-step's start (slot 0 holds the first's) */
+        if (!first) { /* the state of this sub-step's start (slot 0 holds the first's) */
             s = sph__snapshot_take(w, 1);
             if (s != SPH_OK) {
                 sph__snapshot_restore(w, 0);
@@ -7276,6 +7333,7 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
         if (s == SPH_OK) {
             if (dt_min == 0 || dt < dt_min) dt_min = dt;
             in_row = 0;
+            first = 0;
             w->stats.dt_factor = fmin(1.0, 1.1 * w->stats.dt_factor);
             /* land exactly on the end: a float step, or time + dt rounded, may leave a residue
                that a sliver step would make the incompressible solvers treat as a real step */
@@ -7287,10 +7345,25 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
            run of ever smaller steps would only spend the sub-step budget) */
         if ((s == SPH_ERR_UNSTABLE || s == SPH_ERR_NOT_CONVERGED) && in_row < SPH__RETRIES &&
             0.5 * fmin(w->stats.dt_factor, dt / dt_stable) >= 1.0 / 4096) {
-            sph__snapshot_restore(w, substeps > 1 ? 1 : 0);
+            sph__snapshot_restore(w, first ? 0 : 1);
             ++retries;
             ++in_row;
             w->stats.dt_factor = 0.5 * fmin(w->stats.dt_factor, dt / dt_stable);
+            continue;
+        }
+        /* a sub-step that fails at every step from its start may start from a state an earlier
+           sub-step left beyond repair (an accepted step whose actual densities came out beyond
+           what its linearised prediction showed: IISPH at a 1 % tolerance put a particle 20 %
+           over rest density, and every retry of the next sub-step failed on it): the whole call
+           is taken again from its start, at a quarter of the step it began with, at most twice */
+        if ((s == SPH_ERR_UNSTABLE || s == SPH_ERR_NOT_CONVERGED) && !first && restarts < 2) {
+            sph__snapshot_restore(w, 0);
+            ++restarts;
+            ++retries;
+            in_row = 0;
+            first = 1;
+            factor0 *= 0.25;
+            w->stats.dt_factor = factor0;
             continue;
         }
         {
