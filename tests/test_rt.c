@@ -42,12 +42,13 @@
    with the exact sigma, a_0 = 0.002 lambda (k a_0 = 0.013: linear until a/a_0 ~ 30). sigma_SPH is
    the least-squares slope of ln a(t) over sigma t in [0.5, 2.5] (frames of 0.1/sigma).
 
-   Measured (32 across, one thread), sigma_SPH / sigma_exact at A = 0.5 / 0.286:
-     WCSPH, particle density, SPH_PGRAD_DIFFERENCE   1.063 / 1.032 (24 across 1.070 / 1.045,
-                                                      48 across 1.057 / 1.024: converging to 1)
-     WCSPH, particle density, SPH_PGRAD_MULTIPHASE   0.39 at A = 0.5 before the cross-phase delta-SPH
-                                                      fix, about 0.1 after (README; rt-long prints)
-     enhanced PCISPH, particle density (its preset) 0.30 at A = 0.5 (prints)
+   Measured, sigma_SPH / sigma_exact at A = 0.5 / 0.286 (32 across unless said):
+     WCSPH, particle density, SPH_PGRAD_DIFFERENCE   1.060 / 1.027 (24 across 1.066 / 1.038;
+                                                      48 across 1.057 / 1.024, measured before
+                                                      delta-SPH's bound by the stiffer phase)
+     WCSPH, particle density, SPH_PGRAD_MULTIPHASE   0.324 / 0.301
+     WCSPH, particle density, SPH_PGRAD_INTERFACE    0.320 / 0.302
+     enhanced PCISPH, particle density (its preset) 0.300 / 0.107 (the multiphase gradient)
    Why the antisymmetric forms are slow: they carry each particle's absolute pressure,
    sum_j V_j (p_i + p_j) grad W_ij = sum_j V_j (p_j - p_i) grad W_ij + 2 p_i sum_j V_j grad W_ij, and
    the last sum, zero on an undisturbed lattice, changes to first order when neighbouring rows
