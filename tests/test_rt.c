@@ -43,9 +43,8 @@
    the least-squares slope of ln a(t) over sigma t in [0.5, 2.5] (frames of 0.1/sigma).
 
    Measured, sigma_SPH / sigma_exact at A = 0.5 / 0.286 (32 across unless said):
-     WCSPH, particle density, SPH_PGRAD_DIFFERENCE   1.060 / 1.027 (24 across 1.066 / 1.038;
-                                                      48 across 1.057 / 1.024, measured before
-                                                      delta-SPH's bound by the stiffer phase)
+     WCSPH, particle density, SPH_PGRAD_DIFFERENCE   1.060 / 1.027 (24 across 1.066 / 1.038,
+                                                      48 across 1.056 / 1.022: converging)
      WCSPH, particle density, SPH_PGRAD_MULTIPHASE   0.324 / 0.301
      WCSPH, particle density, SPH_PGRAD_INTERFACE    0.320 / 0.302
      enhanced PCISPH, particle density (its preset) 0.300 / 0.107 (the multiphase gradient)
