@@ -120,7 +120,13 @@ int main(void) {
    asks for c0 = 10 max(sqrt(2 |g| H), |v|max), chosen at the first step, so density varies by
    about 1 %. Density by continuity (default) with delta-SPH diffusion (Molteni & Colagrossi
    2009, delta = 0.1), by summation (negative pressures then clamped), or by Ott & Schnetter's
-   particle-density continuity for phases of very different density. Viscosity: Monaghan's
+   particle-density continuity for phases of very different density. Phases: with particle
+   density, the multiphase (or interface) pressure gradient holds layers at rest (a 1000/500/100
+   kg/m^3 column at 20 across after 2 s: 0.9 % of sqrt(g H), pressure within 2.3 %,
+   tests/test_layers.c), while SPH_PGRAD_DIFFERENCE lets buoyancy-driven interfaces move as they should (Rayleigh-Taylor
+   growth within 7 % of the viscous theory at Atwood 0.5 and 0.29, where the antisymmetric forms
+   grow 3-10 times too slowly, tests/test_rt.c; it fails, reported, on the 10:1 column); delta-SPH
+   diffuses pressure, not rho/rho0, across a phase interface. Viscosity: Monaghan's
    artificial viscosity (alpha = 0.02 by default) and a laminar viscosity per phase (Morris et al.
    1997 by default, or the 2(d+2) form of Enhanced PCISPH 2018 eq. 2.5); see VISCOSITY below
    (all solvers share the term). Time integration:
@@ -697,11 +703,21 @@ typedef enum sph_pressure_grad {
     SPH_PGRAD_SYMMETRIC = 0, /* sum_j m_j (p_i/rho_i^2 + p_j/rho_j^2) grad W_ij  (default)        */
     SPH_PGRAD_MULTIPHASE,    /* sum_j m_j (p_i + p_j)/(rho_i rho_j) grad W_ij (large density ratios;
                                 Ott & Schnetter eq. 12)                                          */
-    SPH_PGRAD_INTERFACE      /* 1/m_i sum_j (V_i^2 + V_j^2) p_ij grad W_ij, V = m/rho, with the
+    SPH_PGRAD_INTERFACE,     /* 1/m_i sum_j (V_i^2 + V_j^2) p_ij grad W_ij, V = m/rho, with the
                                 density-weighted p_ij = (rho_j p_i + rho_i p_j)/(rho_i + rho_j)
                                 (Hu & Adams 2006; Adami, Hu & Adams 2013 eq. 7-8): eq. 12 inside
                                 a phase; at an interface the light side sees its own pressure,
                                 which holds a 1000:1 interface under gravity                    */
+    SPH_PGRAD_DIFFERENCE     /* sum_j m_j (p_j - p_i)/(rho_i rho_j) grad W_ij: the multiphase form
+                                without its zeroth-order error 2 p_i sum_j V_j grad W_ij, so a
+                                uniform pressure exerts no force on any particle arrangement and
+                                rows of particles slide past each other freely (buoyancy-driven
+                                interfaces: Rayleigh-Taylor growth within 10 % of the viscous
+                                theory, tests/test_rt.c, where the forms above grow 3-10 times
+                                too slowly). Not pairwise antisymmetric: momentum is conserved
+                                only to the discretisation error. WCSPH only (sph_world_init
+                                rejects it for the other solvers: PCISPH's gain and the
+                                compressible step's energy need the antisymmetric forms)       */
 } sph_pressure_grad;
 
 typedef enum sph_integrator {
@@ -2627,8 +2643,11 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
                (double)d->divergence_tolerance);
     SPH__CHECK((int)d->density >= 0 && d->density <= SPH_DENSITY_PARTICLE,
                "sph_world_def.density = %d: not a sph_density", (int)d->density);
-    SPH__CHECK((int)d->pressure_grad >= 0 && d->pressure_grad <= SPH_PGRAD_INTERFACE,
+    SPH__CHECK((int)d->pressure_grad >= 0 && d->pressure_grad <= SPH_PGRAD_DIFFERENCE,
                "sph_world_def.pressure_grad = %d: not a sph_pressure_grad", (int)d->pressure_grad);
+    SPH__CHECK(d->pressure_grad != SPH_PGRAD_DIFFERENCE || d->solver == SPH_SOLVER_WCSPH,
+               "sph_world_def.pressure_grad = SPH_PGRAD_DIFFERENCE: WCSPH only (solver %d)",
+               (int)d->solver);
     SPH__CHECK((int)d->integrator >= 0 && d->integrator <= SPH_INTEGRATOR_VERLET,
                "sph_world_def.integrator = %d: not a sph_integrator", (int)d->integrator);
     SPH__CHECK((int)d->scheme >= 0 && d->scheme <= SPH_SCHEME_SECOND_ORDER,
@@ -4243,6 +4262,31 @@ SPH__INLINE sph_real sph__pgrad_interface(sph_real mi, sph_real rhoi, sph_real p
     return -(Vi * Vi + Vj * Vj) / mi * (rhoj * pi + rhoi * pj) / (rhoi + rhoj);
 }
 
+/* delta-SPH's difference for a pair of different phases (i's phase P). In a fluid at rest the
+   pressure is continuous across an interface and each phase's equation of state turns it into
+   its own relative density, so rho/rho0 jumps there (by p (1/(rho0_i c_i^2) - 1/(rho0_j c_j^2))
+   to first order: 1 % at a 3:1 interface under 3 Pa with c0 = 14 m/s). Diffusing rho/rho0 across
+   the interface, as within a phase, would drive that jump to zero against the pressure balance
+   for as long as the fluid rests: a standing flow along the interface (measured on a flat 3:1
+   interface, WCSPH, particle density, velocities zeroed every 0.02 s: the rows next to it keep
+   0.006 m/s after 2 s; 0 with delta = 0 or with this difference), which also damped the
+   Rayleigh-Taylor growth (tests/test_rt.c). So WCSPH's pair diffuses pressure: rho_i/rho0_i minus
+   the relative density phase P would have at p_j, linearised, (p_i - p_j) / K with K = rho0 c0^2
+   the bulk modulus; zero wherever the pressure is continuous. K is the larger of the two phases':
+   the soft phase's own K would let the stiff phase's pressure noise drive it (water under air at
+   1000:1 in the compressible step: the air compressed by 20 % within 0.003 s). PCISPH holds every
+   phase at its own rest density (rho/rho0 = 1 on both sides at rest) and has no equation of
+   state, and the compressible step's per-particle sound speeds (gases) are not one phase's
+   modulus (its 1000:1 interface at rest, tests/test_compressible.c, kept the air 20 % calmer
+   with the plain difference): both keep it. */
+SPH__INLINE sph_real sph__delta_across(const sph__ctx* c, const sph__phase_c* P,
+                                       const sph__phase_c* Pj, sph_real rhati, sph_real rhatj,
+                                       sph_real pi, sph_real pj) {
+    const sph_real Ki = P->rho0 * P->c0 * P->c0, Kj = Pj->rho0 * Pj->c0 * Pj->c0;
+    if (!c->eos_walls || c->cs || !(Ki > 0) || !(Kj > 0)) return rhati - rhatj;
+    return (pi - pj) / (Ki > Kj ? Ki : Kj);
+}
+
 SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, const int flags,
                                    sph_real* acc, sph_real* rate, const int fast) {
     /* fast (a compile-time constant, see sph__stage_interact): the common configuration, known
@@ -4292,7 +4336,9 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
             R += (os ? mi : mj) * fw * vd;
             if (c->delta_on)
                 R += dcoef * ((fast && c->volc) ? c->volc[j] : mj / rhoj) *
-                     (rhati - rhoj * Pj->inv_rho0) * fw * r2 / (r2 + c->eta2);
+                     (Pj == P ? rhati - rhoj * Pj->inv_rho0
+                              : sph__delta_across(c, P, Pj, rhati, rhoj * Pj->inv_rho0, pi, c->p[j])) *
+                     fw * r2 / (r2 + c->eta2);
         }
         if (flags & SPH__PRESSURE) {
             const sph_real pj = c->p[j];
@@ -4300,6 +4346,7 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
                 s = -mj * (pi_r2 + ((flags & SPH__CACHED) ? c->pr2[j]
                                     : (fast && c->pr2c) ? c->pr2c[j] : pj / (rhoj * rhoj)));
             else if (pgrad == SPH_PGRAD_MULTIPHASE) s = -mj * (pi + pj) * inv_rhoi / rhoj;
+            else if (pgrad == SPH_PGRAD_DIFFERENCE) s = -mj * (pj - pi) * inv_rhoi / rhoj;
             else s = sph__pgrad_interface(mi, rhoi, pi, mj, rhoj, pj);
         }
         if (flags & SPH__VISCOUS) {
@@ -4360,6 +4407,7 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
                                                                      : 0;
                 if (pgrad == SPH_PGRAD_SYMMETRIC) s = -psi * (pi_r2 + pb / (rhob * rhob));
                 else if (pgrad == SPH_PGRAD_MULTIPHASE) s = -psi * (pi + pb) * inv_rhoi / rhob;
+                else if (pgrad == SPH_PGRAD_DIFFERENCE) s = -psi * (pb - pi) * inv_rhoi / rhob;
                 else s = sph__pgrad_interface(mi, rhoi, pi, psi, rhob, pb);
             }
             if ((flags & SPH__VISCOUS) && c->noslip && (laminar || c->av)) {

@@ -49,6 +49,8 @@ extern const th_test tests_viscous[]; /* viscous accuracy and dissipation (issue
 extern const th_test tests_viscous_long[];
 extern const th_test tests_layers[]; /* layered columns at rest (issue 18, item 1) */
 extern const th_test tests_layers_long[];
+extern const th_test tests_rt[]; /* Rayleigh-Taylor linear growth (issue 18, item 2) */
+extern const th_test tests_rt_long[];
 
 void th_fail(const char* file, int line, const char* fmt, ...);
 void th_note(const char* fmt, ...);
