@@ -39,6 +39,8 @@
                           the allocator (define all three or none; default libc)
        SPH_ASSERT(cond)   internal invariants (default assert); never used for user input
        SPH_VALIDATE       expensive self-checks (neighbour-list symmetry), for tests
+       SPH_NO_SIMD        no SSE2 intrinsics (x86-64 uses them in the pair loops by default;
+                          the results are bitwise the same either way)
        SPH_MAX_PHASES     phases per world (default 16; at most 256, phase indices are uint8_t)
    OpenMP is used when the compiler enables it (-fopenmp); otherwise everything runs serially.
 
@@ -1431,6 +1433,7 @@ SPHDEF sph_status sph_world_copy(sph_world* dst, const sph_world* src);
 #define SPH__R(x) ((sph_real)(x))
 typedef ptrdiff_t sph__idx; /* signed loop index for OpenMP */
 
+
 #ifdef SPH_FLOAT
 SPH__INLINE sph_real sph__sqrt(sph_real x) { return sqrtf(x); }
 SPH__INLINE sph_real sph__exp(sph_real x) { return expf(x); }
@@ -1444,6 +1447,59 @@ SPH__INLINE sph_real sph__pow(sph_real x, sph_real y) { return pow(x, y); }
 SPH__INLINE sph_real sph__fabs(sph_real x) { return fabs(x); }
 SPH__INLINE sph_real sph__floor(sph_real x) { return floor(x); }
 #endif
+
+/* Packed arithmetic for the pair terms of a neighbour row (sph__interact_one's fast path). SSE2
+   is part of x86-64, so a plain -O2 build gets it (gcc 12 at -O2 vectorises none of these loops
+   itself: its cost model allows no loop of unknown trip count, and it will not pack sqrt without
+   -fno-math-errno). IEEE add, mul, div and sqrt round a lane exactly as the scalar instruction,
+   so the packed and the scalar path give the same bits. SPH_NO_SIMD, or another architecture,
+   selects the scalar path (make check builds it). sph__vlt gives a mask (every bit of a lane set
+   where a < b), sph__vand keeps a where the mask is set and gives +0 elsewhere. */
+#if !defined(SPH_NO_SIMD) && (defined(__SSE2__) || defined(_M_X64) || \
+                              (defined(_M_IX86_FP) && _M_IX86_FP >= 2))
+#include <emmintrin.h>
+#ifdef SPH_FLOAT
+#define SPH__VN 4
+typedef __m128 sph__v;
+SPH__INLINE sph__v sph__vload(const sph_real* p) { return _mm_loadu_ps(p); }
+SPH__INLINE void sph__vstore(sph_real* p, sph__v a) { _mm_storeu_ps(p, a); }
+SPH__INLINE sph__v sph__vset(sph_real a) { return _mm_set1_ps(a); }
+SPH__INLINE sph__v sph__vadd(sph__v a, sph__v b) { return _mm_add_ps(a, b); }
+SPH__INLINE sph__v sph__vsub(sph__v a, sph__v b) { return _mm_sub_ps(a, b); }
+SPH__INLINE sph__v sph__vmul(sph__v a, sph__v b) { return _mm_mul_ps(a, b); }
+SPH__INLINE sph__v sph__vdiv(sph__v a, sph__v b) { return _mm_div_ps(a, b); }
+SPH__INLINE sph__v sph__vsqrt(sph__v a) { return _mm_sqrt_ps(a); }
+SPH__INLINE sph__v sph__vlt(sph__v a, sph__v b) { return _mm_cmplt_ps(a, b); }
+SPH__INLINE sph__v sph__vand(sph__v m, sph__v a) { return _mm_and_ps(m, a); }
+#else
+#define SPH__VN 2
+typedef __m128d sph__v;
+SPH__INLINE sph__v sph__vload(const sph_real* p) { return _mm_loadu_pd(p); }
+SPH__INLINE void sph__vstore(sph_real* p, sph__v a) { _mm_storeu_pd(p, a); }
+SPH__INLINE sph__v sph__vset(sph_real a) { return _mm_set1_pd(a); }
+SPH__INLINE sph__v sph__vadd(sph__v a, sph__v b) { return _mm_add_pd(a, b); }
+SPH__INLINE sph__v sph__vsub(sph__v a, sph__v b) { return _mm_sub_pd(a, b); }
+SPH__INLINE sph__v sph__vmul(sph__v a, sph__v b) { return _mm_mul_pd(a, b); }
+SPH__INLINE sph__v sph__vdiv(sph__v a, sph__v b) { return _mm_div_pd(a, b); }
+SPH__INLINE sph__v sph__vsqrt(sph__v a) { return _mm_sqrt_pd(a); }
+SPH__INLINE sph__v sph__vlt(sph__v a, sph__v b) { return _mm_cmplt_pd(a, b); }
+SPH__INLINE sph__v sph__vand(sph__v m, sph__v a) { return _mm_and_pd(m, a); }
+#endif
+#else
+#define SPH__VN 1
+typedef sph_real sph__v;
+SPH__INLINE sph__v sph__vload(const sph_real* p) { return *p; }
+SPH__INLINE void sph__vstore(sph_real* p, sph__v a) { *p = a; }
+SPH__INLINE sph__v sph__vset(sph_real a) { return a; }
+SPH__INLINE sph__v sph__vadd(sph__v a, sph__v b) { return a + b; }
+SPH__INLINE sph__v sph__vsub(sph__v a, sph__v b) { return a - b; }
+SPH__INLINE sph__v sph__vmul(sph__v a, sph__v b) { return a * b; }
+SPH__INLINE sph__v sph__vdiv(sph__v a, sph__v b) { return a / b; }
+SPH__INLINE sph__v sph__vsqrt(sph__v a) { return sph__sqrt(a); }
+SPH__INLINE sph__v sph__vlt(sph__v a, sph__v b) { return a < b ? 1 : 0; }
+SPH__INLINE sph__v sph__vand(sph__v m, sph__v a) { return m != 0 ? a : 0; }
+#endif
+
 SPH__INLINE int sph__finite(double x) { return x == x && x - x == 0.0; }
 SPH__INLINE sph_real sph__min(sph_real a, sph_real b) { return a < b ? a : b; }
 SPH__INLINE sph_real sph__max(sph_real a, sph_real b) { return a > b ? a : b; }
@@ -3526,6 +3582,7 @@ typedef struct sph__ctx {
     int density, pgrad, noslip, laminar, morris, av, delta_on;
     int bp_mode;               /* sph_boundary_pressure                                          */
     const sph_real *ff_fw, *fb_fw; /* cached grad W factors per listed pair (SPH__CACHED passes)  */
+    sph_real *ff_fw_out, *fb_fw_out; /* where SPH__STORE passes write them                        */
     sph_real delta_c;          /* if > 0, the speed in the delta-SPH term instead of each phase's c0 */
     const sph_real* pr2;       /* p / rho^2 per fluid particle (SPH__CACHED passes)              */
     const sph_real *pr2c, *volc; /* p / rho^2 and m / rho per fluid particle for fast-path passes
@@ -4187,9 +4244,12 @@ static void sph__stage_visc_norm(sph_world* w, const sph__ctx* c) {
 
 /* What a pass of the neighbour loop computes: pressure acceleration, viscous acceleration,
    density rate; SET overwrites the acceleration output instead of adding to it; ENERGY (with
-   PRESSURE, VISCOUS and RATE) computes the internal energy rate instead of an acceleration. */
+   PRESSURE, VISCOUS and RATE) computes the internal energy rate instead of an acceleration.
+   CACHED reads the grad W factor of every listed pair from c->ff_fw / fb_fw instead of
+   evaluating the kernel; STORE writes the factors it evaluates to c->ff_fw_out / fb_fw_out, for
+   a later pass at the same positions (WCSPH's density rate after its forces). */
 enum { SPH__PRESSURE = 1, SPH__VISCOUS = 2, SPH__RATE = 4, SPH__SET = 8, SPH__CACHED = 16,
-       SPH__ENERGY = 32 };
+       SPH__ENERGY = 32, SPH__STORE = 64 };
 #define SPH__ACCEL (SPH__PRESSURE | SPH__VISCOUS)
 
 /* The one neighbour loop for accelerations and the density rate of fluid particle i.
@@ -4231,6 +4291,82 @@ SPH__INLINE sph_real sph__pgrad_interface(sph_real mi, sph_real rhoi, sph_real p
     return -(Vi * Vi + Vj * Vj) / mi * (rhoj * pi + rhoi * pj) / (rhoi + rhoj);
 }
 
+#define SPH__ROW 64 /* neighbours per batch of sph__accel_row */
+
+/* sph__interact_one's fluid pairs on the fast path (flags ACCEL, with or without STORE), in
+   batches of SPH__ROW neighbours: a gather loop reads each neighbour in list order, a packed
+   loop (SPH__VN lanes) does the square root, the kernel and the two divisions of the artificial
+   viscosity (branch-free: a receding pair's lane is masked to +0, and s - (+0) is s), and a
+   last loop adds the pair forces in list order. Every lane computes the plain loop's
+   expressions in the plain loop's order and the sums are taken in the same order, so the
+   result has the same bits. The packed loop replaces a branch on the sign of v_ij . x_ij that
+   went either way at random. [adds to ai, m/s^2] */
+SPH__INLINE void sph__accel_row(const sph__ctx* c, size_t i, const int D, const int flags,
+                                sph_real* ai) {
+    const sph_real* xi = c->x + i * (size_t)D;
+    const sph_real* vi = c->v + i * (size_t)D;
+    const sph__phase_c* P = &c->pc[c->ph[i]];
+    const sph_real rhoi = c->rho[i], mj = c->m0, inv_rhoi = 1 / rhoi;
+    const sph_real pi_r2 = c->p[i] * inv_rhoi * inv_rhoi;
+    const sph_real cbar = SPH__R(0.5) * (P->c0 + P->c0);
+    const sph_real far = 4 * c->k.radius * c->k.radius; /* padding lanes: beyond the support */
+    const sph__v v_inv_h = sph__vset(c->k.inv_h), v_two = sph__vset(2), v_one = sph__vset(1);
+    const sph__v v_half = sph__vset(SPH__R(0.5)), v_m5 = sph__vset(-5);
+    const sph__v v_norm = sph__vset(c->k.norm_g), v_zero = sph__vset(0);
+    const sph__v v_s0 = sph__vset(-mj), v_pi = sph__vset(pi_r2), v_h = sph__vset(c->h);
+    const sph__v v_eta2 = sph__vset(c->eta2), v_ac = sph__vset(-c->alpha * cbar);
+    const sph__v v_beta = sph__vset(c->beta), v_mj = sph__vset(mj), v_rhoi = sph__vset(rhoi);
+    const int av = (flags & SPH__VISCOUS) && c->av;
+    sph_real dd[3][SPH__ROW], r2[SPH__ROW + SPH__VN], ud[SPH__ROW + SPH__VN];
+    sph_real pr[SPH__ROW + SPH__VN], rj[SPH__ROW + SPH__VN], fs[SPH__ROW + SPH__VN];
+    sph_real fwo[SPH__ROW + SPH__VN];
+    size_t b0, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
+    int k;
+    for (b0 = k0; b0 < k1; b0 += SPH__ROW) {
+        const size_t nb = k1 - b0 < SPH__ROW ? k1 - b0 : SPH__ROW;
+        size_t m;
+        for (m = 0; m < nb; ++m) {
+            const size_t j = c->ff->idx[b0 + m];
+            const sph_real* xj = c->x + j * (size_t)D;
+            const sph_real* vj = c->v + j * (size_t)D;
+            sph_real d[3] = {0, 0, 0}, rr = 0, vd = 0;
+            SPH__FOR_K(D, d[k] = xi[k] - xj[k]; dd[k][m] = d[k]);
+            SPH__FOR_K(D, rr += d[k] * d[k]);
+            if (flags & SPH__VISCOUS) SPH__FOR_K(D, vd += (vi[k] - vj[k]) * d[k]);
+            r2[m] = rr;
+            ud[m] = vd;
+            rj[m] = c->rho[j];
+            if (flags & SPH__PRESSURE) pr[m] = c->pr2c ? c->pr2c[j] : c->p[j] / (rj[m] * rj[m]);
+        }
+        for (; m % SPH__VN; ++m) { r2[m] = far; ud[m] = 0; rj[m] = 1; pr[m] = 0; }
+        for (m = 0; m < nb; m += SPH__VN) {
+            const sph__v vr2 = sph__vload(r2 + m);
+            const sph__v q = sph__vmul(sph__vsqrt(vr2), v_inv_h);
+            const sph__v t = sph__vsub(v_one, sph__vmul(v_half, q));
+            const sph__v t3 = sph__vmul(sph__vmul(sph__vmul(v_m5, t), t), t); /* -5 t^3 */
+            const sph__v kf = sph__vand(sph__vlt(q, v_two), t3); /* Wendland C2's f(q) */
+            const sph__v fw = sph__vmul(v_norm, kf);
+            sph__v sv = v_zero;
+            if (flags & SPH__PRESSURE) sv = sph__vmul(v_s0, sph__vadd(v_pi, sph__vload(pr + m)));
+            if (av) {
+                const sph__v u = sph__vload(ud + m);
+                const sph__v mu = sph__vdiv(sph__vmul(v_h, u), sph__vadd(vr2, v_eta2));
+                const sph__v pv =
+                    sph__vadd(sph__vmul(v_ac, mu), sph__vmul(sph__vmul(v_beta, mu), mu));
+                const sph__v term = sph__vdiv(sph__vmul(sph__vmul(v_mj, pv), v_two),
+                                              sph__vadd(v_rhoi, sph__vload(rj + m)));
+                sv = sph__vsub(sv, sph__vand(sph__vlt(u, v_zero), term));
+            }
+            sph__vstore(fs + m, sph__vmul(sv, fw));
+            sph__vstore(fwo + m, fw);
+        }
+        for (m = 0; m < nb; ++m) {
+            if (flags & SPH__STORE) c->ff_fw_out[b0 + m] = fwo[m];
+            SPH__FOR_K(D, ai[k] += fs[m] * dd[k][m]);
+        }
+    }
+}
+
 SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, const int flags,
                                    sph_real* acc, sph_real* rate, const int fast) {
     /* fast (a compile-time constant, see sph__stage_interact): the common configuration, known
@@ -4259,7 +4395,9 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
     sph_real ai[3] = {0, 0, 0}, R = 0, E = 0;
     size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
     int k;
-    for (kk = k0; kk < k1; ++kk) {
+    if (fast && (flags & SPH__ACCEL) && !(flags & (SPH__RATE | SPH__CACHED | SPH__ENERGY)))
+        sph__accel_row(c, i, D, flags, ai);
+    else for (kk = k0; kk < k1; ++kk) {
         const size_t j = c->ff->idx[kk];
         const sph_real* xj = c->x + j * (size_t)D;
         const sph_real* vj = c->v + j * (size_t)D;
@@ -4276,6 +4414,7 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
         if (en) { ud = 0; SPH__FOR_K(D, ud += (ui[k] - uj[k]) * d[k]); }
         if (flags & SPH__CACHED) fw = c->ff_fw[kk]; /* grad W = fw d */
         else fw = c->k.norm_g * sph__kf(form, sph__sqrt(r2) * c->k.inv_h);
+        if (flags & SPH__STORE) c->ff_fw_out[kk] = fw;
         if (flags & SPH__RATE) {
             R += (os ? mi : mj) * fw * vd;
             if (c->delta_on)
@@ -4338,6 +4477,7 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
             if (en) SPH__FOR_K(D, ud += (ui[k] - vb[k]) * d[k]);
             if (flags & SPH__CACHED) fw = c->fb_fw[kk];
             else fw = c->k.norm_g * sph__kf(form, sph__sqrt(r2) * c->k.inv_h);
+            if (flags & SPH__STORE) c->fb_fw_out[kk] = fw;
             if (flags & SPH__RATE) {
                 R += psi * fw * vd; /* the wall's own velocity: a moving wall compresses */
                 if (c->delta_on) R += dcoef * Vb * (rhati - kap) * fw * r2 / (r2 + c->eta2);
@@ -4409,26 +4549,28 @@ static void sph__stage_interact(sph_world* w, const sph__ctx* c, int flags, sph_
 #define SPH__LOOP(D, FL, F)                                                                        \
     for (i = i0; i < i1; ++i) sph__interact_one(c, i, D, FL, acc, w->drho, F)
 #define SPH__CASES(D, F)                                                                           \
-    case (F) * 256 + D * 64 + SPH__ACCEL: SPH__LOOP(D, SPH__ACCEL, F); break;                      \
-    case (F) * 256 + D * 64 + SPH__VISCOUS: SPH__LOOP(D, SPH__VISCOUS, F); break;                  \
-    case (F) * 256 + D * 64 + (SPH__PRESSURE | SPH__SET):                                          \
+    case (F) * 512 + D * 128 + SPH__ACCEL: SPH__LOOP(D, SPH__ACCEL, F); break;                     \
+    case (F) * 512 + D * 128 + (SPH__ACCEL | SPH__STORE):                                          \
+        SPH__LOOP(D, SPH__ACCEL | SPH__STORE, F); break;                                           \
+    case (F) * 512 + D * 128 + SPH__VISCOUS: SPH__LOOP(D, SPH__VISCOUS, F); break;                 \
+    case (F) * 512 + D * 128 + (SPH__PRESSURE | SPH__SET):                                         \
         SPH__LOOP(D, SPH__PRESSURE | SPH__SET, F); break;                                          \
-    case (F) * 256 + D * 64 + (SPH__PRESSURE | SPH__SET | SPH__CACHED):                            \
+    case (F) * 512 + D * 128 + (SPH__PRESSURE | SPH__SET | SPH__CACHED):                           \
         SPH__LOOP(D, SPH__PRESSURE | SPH__SET | SPH__CACHED, F); break;                            \
-    case (F) * 256 + D * 64 + SPH__RATE: SPH__LOOP(D, SPH__RATE, F); break;                        \
-    case (F) * 256 + D * 64 + (SPH__RATE | SPH__CACHED):                                           \
+    case (F) * 512 + D * 128 + SPH__RATE: SPH__LOOP(D, SPH__RATE, F); break;                       \
+    case (F) * 512 + D * 128 + (SPH__RATE | SPH__CACHED):                                          \
         SPH__LOOP(D, SPH__RATE | SPH__CACHED, F); break;
-        switch (fast * 256 + c->dim * 64 + flags) {
+        switch (fast * 512 + c->dim * 128 + flags) {
             SPH__CASES(1, 0)
             SPH__CASES(2, 0)
             SPH__CASES(3, 0)
             SPH__CASES(2, 1)
             SPH__CASES(3, 1)
-        case 1 * 64 + (SPH__RATE | SPH__ACCEL | SPH__ENERGY):
+        case 1 * 128 + (SPH__RATE | SPH__ACCEL | SPH__ENERGY):
             SPH__LOOP(1, SPH__RATE | SPH__ACCEL | SPH__ENERGY, 0); break;
-        case 2 * 64 + (SPH__RATE | SPH__ACCEL | SPH__ENERGY):
+        case 2 * 128 + (SPH__RATE | SPH__ACCEL | SPH__ENERGY):
             SPH__LOOP(2, SPH__RATE | SPH__ACCEL | SPH__ENERGY, 0); break;
-        case 3 * 64 + (SPH__RATE | SPH__ACCEL | SPH__ENERGY):
+        case 3 * 128 + (SPH__RATE | SPH__ACCEL | SPH__ENERGY):
             SPH__LOOP(3, SPH__RATE | SPH__ACCEL | SPH__ENERGY, 0); break;
         default: SPH_ASSERT(0); break;
         }
@@ -5226,6 +5368,19 @@ static void sph__pair_cache(sph_world* w, sph__ctx* c) {
     c->volc = w->priv.vol;
 }
 
+/* The force pass keeps grad W_ij / x_ij of every listed pair, and the density-rate pass of the
+   same positions reads it instead of evaluating the kernel again (the same value, so the same
+   bits). Reserved after the neighbour search, which sizes the lists. */
+static sph_status sph__rate_cache(sph_world* w, sph__ctx* c) {
+    sph_status s;
+    if ((s = sph__scratch(w, &w->priv.ff_fw, w->priv.ff.cap_idx)) != SPH_OK ||
+        (s = sph__scratch(w, &w->priv.fb_fw, w->priv.fb.cap_idx)) != SPH_OK)
+        return s;
+    c->ff_fw = c->ff_fw_out = w->priv.ff_fw;
+    c->fb_fw = c->fb_fw_out = w->priv.fb_fw;
+    return SPH_OK;
+}
+
 /* Symplectic Euler (Enhanced PCISPH 2018 sec. 2.3, "semi-implicit"):
        v^{n+1}   = v^n + dt a(x^n, rho^n, v^n)
        rho^{n+1} = rho^n + dt R(x^n, v^{n+1})          R = density rate (continuity + delta-SPH)
@@ -5251,14 +5406,15 @@ static sph_status sph__step_wcsph_euler(sph_world* w, sph_real dt) {
     sph__ctx c;
     sph_status s = sph__pair_cache_reserve(w);
     if (s == SPH_OK) s = sph__prepare_forces(w, &c, w->time, &t0);
+    if (s == SPH_OK && cont) s = sph__rate_cache(w, &c);
     if (s != SPH_OK) return s;
     sph__pair_cache(w, &c);
-    sph__stage_interact(w, &c, SPH__ACCEL, w->a);
+    sph__stage_interact(w, &c, cont ? SPH__ACCEL | SPH__STORE : SPH__ACCEL, w->a);
     sph__time(w, SPH_STAGE_FORCES, &t0);
     s = sph__integrate(w, &c, dt, 0, 0, 0); /* kick */
     if (s != SPH_OK) return s;
     if (cont) {
-        sph__stage_interact(w, &c, SPH__RATE, NULL);
+        sph__stage_interact(w, &c, SPH__RATE | SPH__CACHED, NULL);
         sph__time(w, SPH_STAGE_DENSITY, &t0);
     }
     ++w->steps;
@@ -5294,11 +5450,12 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
     sph__time(w, SPH_STAGE_BOUNDARY, &t0);
     sorts = w->priv.sorts;
     s = sph__stage_neighbors(w);
+    sph__ctx_init(w, &c);
+    if (s == SPH_OK && cont) s = sph__rate_cache(w, &c);
     if (s != SPH_OK) {
         sph__undo_drift(w, w->priv.xp, sorts);
         return s;
     }
-    sph__ctx_init(w, &c);
     sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
     if (cont) {
         SPH__OMP_FOR(w->n)
@@ -5316,12 +5473,12 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
     sph__time(w, SPH_STAGE_FORCES, &t0);
     if (w->nb > 0) sph__stage_wall(w, &c, SPH__WALL_STATE | SPH__WALL_PRESSURE);
     sph__time(w, SPH_STAGE_PRESSURE, &t0);
-    sph__stage_interact(w, &c, SPH__ACCEL, w->a);
+    sph__stage_interact(w, &c, cont ? SPH__ACCEL | SPH__STORE : SPH__ACCEL, w->a);
     sph__time(w, SPH_STAGE_FORCES, &t0);
     s = sph__integrate(w, &c, half, 0, 0, 0); /* half kick: v = (v^n + v^{n+1}) / 2 */
     if (s != SPH_OK) return s;
     if (cont) {
-        sph__stage_interact(w, &c, SPH__RATE, NULL);
+        sph__stage_interact(w, &c, SPH__RATE | SPH__CACHED, NULL);
         SPH__OMP_FOR(w->n)
         for (i = 0; i < (sph__idx)w->n; ++i) w->rho[i] = w->priv.rho_n[i] + dt * w->drho[i];
         sph__time(w, SPH_STAGE_DENSITY, &t0);
