@@ -310,7 +310,10 @@ int main(void) {
    All allocation goes through SPH_MALLOC/SPH_REALLOC/SPH_FREE. Arrays grow when particles are
    added; scratch and neighbour lists grow when the neighbour count grows and are reused, so a
    step allocates nothing in the steady state. Optional arrays (per-particle mass, Verlet
-   scratch) exist only when used. sph_world_free releases everything the world allocated.
+   scratch) exist only when used. WCSPH with continuity density, IISPH and DFSPH keep the kernel
+   gradient of every listed pair for the step's later passes (8 bytes a pair in double: the 2D
+   WCSPH dam break takes 483 bytes per fluid particle, 283 without). sph_world_free releases
+   everything the world allocated.
 
    ERRORS
    Functions that can fail return sph_status; w.error holds a message with the detail (field,
@@ -1432,7 +1435,6 @@ SPHDEF sph_status sph_world_copy(sph_world* dst, const sph_world* src);
 
 #define SPH__R(x) ((sph_real)(x))
 typedef ptrdiff_t sph__idx; /* signed loop index for OpenMP */
-
 
 #ifdef SPH_FLOAT
 SPH__INLINE sph_real sph__sqrt(sph_real x) { return sqrtf(x); }
@@ -4173,11 +4175,6 @@ static sph_status sph__stage_neighbors(sph_world* w) {
     return SPH_OK;
 }
 
-/* Summation density (Enhanced PCISPH 2018 eq. 2.4), walls as psi = rho0_i V_b (Akinci et al. 2012):
-       rho_i = (m_i W(0) + sum_f m_f W_if + sum_b rho0_i V_b W_ib) / S,
-   S = the kernel's lattice sum (sph__lattice_sum): a particle lattice at spacing dx then has the
-   rest density exactly, instead of 1 % more for Wendland C2 at h = 1.3 dx, which an incompressible
-   solver would remove by expanding the fluid (Meiers 2025's reference code scales W the same way). */
 /* rho_i of one particle; D and the kernel form compile-time constants where the stage knows
    them (the loops over k unroll and d[] stays in registers: 3D IISPH's density stage x2). With
    c->ff_fw_out set (IISPH, DFSPH) it also keeps every pair's grad W factor from the same q, for
@@ -4214,6 +4211,11 @@ SPH__INLINE sph_real sph__density_one(const sph__ctx* c, size_t i, const int D, 
     return (mi * w0 + c->k.norm_w * (sum + c->pc[c->ph[i]].rho0 * sumb)) / S;
 }
 
+/* Summation density (Enhanced PCISPH 2018 eq. 2.4), walls as psi = rho0_i V_b (Akinci et al. 2012):
+       rho_i = (m_i W(0) + sum_f m_f W_if + sum_b rho0_i V_b W_ib) / S,
+   S = the kernel's lattice sum (sph__lattice_sum): a particle lattice at spacing dx then has the
+   rest density exactly, instead of 1 % more for Wendland C2 at h = 1.3 dx, which an incompressible
+   solver would remove by expanding the fluid (Meiers 2025's reference code scales W the same way). */
 static void sph__stage_density_summation(sph_world* w, const sph__ctx* c) {
     const int D = c->dim, form = c->k.form, wc2 = form == SPH__KF_WC2;
     const sph_real w0 = c->k.norm_w * sph__kw(c->k.form, 0), S = w->priv.lattice_sum;
