@@ -112,7 +112,7 @@ run() { # name log cmd...
 }
 export ARCHER_OPTIONS="verbose=1"
 run "tests (determinism, golden_hash_threads)" "$B/tests.log" \
-    "./$B/tests" determinism golden_hash_threads
+    "./$B/tests" -j 1 determinism golden_hash_threads
 run "operators driver" "$B/ops_driver.log" "./$B/ops_driver"
 if ! grep -q 'Archer detected OpenMP application with TSan' "$B/tests.log"; then
     echo "check_tsan: Archer did not load ($ARCHER): OpenMP synchronisation unknown to TSan"
