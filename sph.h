@@ -229,8 +229,8 @@ int main(void) {
    steps. A solve that ends at max_iterations above its tolerance finishes the step and returns
    SPH_ERR_NOT_CONVERGED. All three boundary schemes work on open tanks (MIRROR and EXTRAPOLATE
    run the divergence solve with mirrored walls: its pressure balances no weight); a fluid that
-   fills a closed box needs SPH_BP_ZERO (with walls that copy the fluid's pressure it has no
-   pressure level, and DFSPH blows up). Phases may differ in rest density and mass (summation
+   fills a closed box is solved with zero wall pressure whatever the scheme (with walls that
+   copy the fluid's pressure it has no pressure level: see sph__enclosed). Phases may differ in rest density and mass (summation
    density: ratios near 1). Measured (tests/test_dfsph.c, 2D dam break, 20 particles per a, the
    same fixed dt, one thread): 3.5 iterations per step (1.0 of them divergence) against IISPH's
    2.6, 1.41 against 1.30 ms per step, the same compression and front; on a tank at rest 31
@@ -5334,37 +5334,51 @@ static sph_real sph__standing_keep(const sph_world* w) {
    above rho0 everywhere (1e-5 after one step, 3.5e-3 after twenty in a 2D box of 2500), every
    Jacobi sweep adds omega <s> / a_ii to the constant mode, the pressure level climbs (1.3 to
    22 kPa in 22 steps), the step shrinks, a_ii ~ dt^2 makes the drift grow like 1 / dt^2, and the
-   fluid gains energy until it blows up. The compatibility condition of the discrete problem is
-   sum_i s_i = 0 (the constant being the null vector); when no free surface anchors the pressure
-   level -- fewer than 0.2 n^((d-1)/d) particles (a fifth of one lattice face of the fluid) have
-   fewer than 0.85 of a full lattice neighbourhood of fluid and wall particles (not a density
-   test: the incompressible solvers compress a free surface's top layer to rho0 as it settles,
-   and a vortex's core thins out); a few particles in a vortex's core do not anchor it, the
-   Jacobi sweeps would take thousands of iterations to lift the level through them -- the mean of
-   the source is removed, and the solve controls the density differences, which a fixed volume of
-   fluid can satisfy. The uniform part, a summation-density bias of the disordered lattice, is
-   left alone (in a 2D box with a vortex it reaches about 4 % by 0.4 s). With ZERO walls the
-   wall pressure anchors the level and nothing is done. Deterministic: one serial pass. IISPH and
-   DFSPH project; PCISPH instead runs an enclosed fluid's correction with zero wall pressure, the
-   density constraint's own wall term (derived in sph__step_pcisph), which has no null mode. */
-static int sph__enclosed(const sph_world* w) {
-    const double D = (double)w->dim;
-    const double anchor = fmax(1.0, 0.2 * pow((double)w->n, (D - 1) / D));
+   fluid gains energy until it blows up. PCISPH, IISPH and DFSPH therefore solve an enclosed
+   fluid with the density constraint's own wall term, p_b = 0 (derived in sph__step_pcisph), which
+   has no null mode: a uniform pressure pushes the first fluid layer off the walls.
+   Enclosed means that no free surface anchors the pressure level: fewer than 0.2 n^((d-1)/d)
+   particles (a fifth of one lattice face of the fluid) lie on a surface. A surface particle has
+   fewer than 0.85 of a full lattice neighbourhood of fluid and wall particles, and a lopsided one:
+   the mean offset |sum_j (x_j - x_i)| / N_i of its N_i fluid and wall neighbours exceeds 0.3 dx
+   (a lattice's top layer has about 0.9 dx, its second layer about 0.45). The count alone did
+   not tell a surface from a wall: the incompressible solvers compress a tank's top layer to
+   rho0 as it settles (IISPH's 2D tank at rest: 5 of its 40 top particles below 0.7 of a full set
+   by 3 s), a particle in the corner of a box the fluid fills keeps 0.81-0.84 (3D vortex box, dx =
+   0.05 m), and a vortex's core thins out; there the mean offsets stay below 0.2 dx (measured in
+   tests/test_scenes.c's and tests/test_reliability.c's vortex boxes), on tank surfaces mostly
+   0.4-1.1 dx. A wrong call turned the walls back to the copied pressure every few steps: IISPH's
+   3D box needed 17 retries and DFSPH's kinetic energy rose by 0.2 of its start in one frame.
+   With ZERO walls the wall pressure anchors the level and nothing changes. Deterministic: one
+   serial pass, stopped at the anchor count; the neighbour offsets are summed only for the
+   particles short of neighbours. */
+static int sph__enclosed(const sph_world* w, const sph__ctx* c) {
+    const int D = w->dim;
+    const double anchor = fmax(1.0, 0.2 * pow((double)w->n, (D - 1.0) / D));
     const double need = 0.85 * (double)w->priv.full_count;
     size_t i, surface = 0;
     if (w->def.boundary_pressure == SPH_BP_ZERO || w->nb == 0 || w->n == 0) return 0;
-    for (i = 0; i < w->n; ++i)
-        surface += (double)w->priv.ff.count[i] + (double)w->priv.fb.count[i] < need;
+    for (i = 0; i < w->n && (double)surface < anchor; ++i) {
+        const size_t nf = w->priv.ff.count[i], nw = w->priv.fb.count[i];
+        const sph_real* xi = c->x + i * (size_t)D;
+        double s[3] = {0, 0, 0}, s2 = 0;
+        size_t kk;
+        int k;
+        if ((double)(nf + nw) >= need) continue;
+        for (kk = 0; kk < nf; ++kk) { /* sum of the offsets x_j - x_i [m] */
+            sph_real d[3];
+            sph__delta_vec(c, c->x + w->priv.ff.idx[w->priv.ff.begin[i] + kk] * (size_t)D, xi, d, D);
+            for (k = 0; k < D; ++k) s[k] += (double)d[k];
+        }
+        for (kk = 0; kk < nw; ++kk) {
+            sph_real d[3];
+            sph__delta_vec(c, c->bx + w->priv.fb.idx[w->priv.fb.begin[i] + kk] * (size_t)D, xi, d, D);
+            for (k = 0; k < D; ++k) s[k] += (double)d[k];
+        }
+        for (k = 0; k < D; ++k) s2 += s[k] * s[k];
+        surface += nf + nw == 0 || sqrt(s2) > 0.3 * (double)(nf + nw) * (double)w->dx;
+    }
     return (double)surface < anchor;
-}
-
-static void sph__enclosed_projection(sph_world* w, sph_real* src) {
-    double mean = 0;
-    size_t i;
-    if (!sph__enclosed(w)) return;
-    for (i = 0; i < w->n; ++i) mean += (double)src[i];
-    mean /= (double)w->n;
-    for (i = 0; i < w->n; ++i) src[i] -= (sph_real)mean;
 }
 
 /* Divergence of relaxed Jacobi. The weight converges only while omega lambda_max(D^-1 A) < 2,
@@ -6351,10 +6365,10 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
     }
     memset(w->priv.ap, 0, nD * sizeof(sph_real));
     keep = sph__standing_keep(w);
-    if (sph__enclosed(w)) { /* from the density at x^n */
+    if (sph__enclosed(w, &c)) { /* from the density at x^n */
         /* An enclosed fluid with walls that copy its pressure (extrapolated, mirrored): the
-           correction runs with the wall term of the density constraint instead, p_b = 0, and
-           needs no compatibility projection (sph__enclosed's, which IISPH and DFSPH keep).
+           correction runs with the wall term of the density constraint instead, p_b = 0 (as
+           IISPH's and DFSPH's solves do, see sph__enclosed).
            The constraint is C_i = rho*_i with the continuity rate (Enhanced PCISPH 2018 eq. 3.2)
                R_i = sum_j m_j v_ij . grad W_ij + sum_b psi_b v_ib . grad W_ib,  psi_b = rho0 V_b,
            whose pressure force as a constraint force (Koschier et al. 2019 tutorial: the
@@ -6865,6 +6879,7 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
     c.pr2 = w->priv.pr2;
     c.delta_on = 0;          /* the density is a summation, no diffusion */
     c.density = SPH_DENSITY_CONTINUITY;
+    if (sph__enclosed(w, &c)) c.bp_mode = SPH_BP_ZERO; /* no pressure level: see sph__enclosed */
     sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
     sph__stage_density_summation(w, &c);
     sph__time(w, SPH_STAGE_DENSITY, &t0);
@@ -6883,7 +6898,6 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
         else sph__iisph_prepare_one(w, &c, (size_t)i, 1, dt);
         w->p[i] = w->p[i] > 0 ? sph__warm(w) * w->p[i] : 0;
     }
-    sph__enclosed_projection(w, w->priv.src);
     if (w->def.pressure_solve == SPH_PSOLVE_CG && c.bp_mode == SPH_BP_ZERO) {
         if ((s = sph__iisph_cg(w, &c, dt, &it, &err, &errmax)) != SPH_OK) return s;
     } else {
@@ -7103,16 +7117,6 @@ static double sph__dfsph_error(sph_world* w, const sph__ctx* c, sph_real dt, int
         }
         w->priv.block[blk] = e;
     }
-    if (density && sph__enclosed(w)) { /* no pressure level of its own: see sph__enclosed */
-        double mean = 0;
-        for (q = 0; q < w->n; ++q) mean += (double)w->drho[q];
-        mean /= (double)w->n;
-        for (q = 0; q < w->n; ++q) {
-            w->drho[q] -= (sph_real)mean;
-            if (w->drho[q] > 0) sum += (double)(w->drho[q] * c->pc[c->ph[q]].inv_rho0);
-        }
-        return sum / (double)w->n;
-    }
     for (q = 0; q < nblk; ++q) sum += w->priv.block[q];
     return w->n ? sum / (double)w->n : 0;
 }
@@ -7188,6 +7192,7 @@ static sph_status sph__step_dfsph(sph_world* w, sph_real dt) {
     c.delta_on = 0; /* the density is a summation: its rate is plain continuity */
     c.density = SPH_DENSITY_CONTINUITY;
     c.pgrad = SPH_PGRAD_SYMMETRIC; /* p = kappa rho: the paper's pressure acceleration */
+    if (sph__enclosed(w, &c)) c.bp_mode = SPH_BP_ZERO; /* both solves: see sph__enclosed */
     cv = c;                        /* the divergence solve: its own pressure, walls as above */
     cv.p = w->priv.df_pv;
     if (cv.bp_mode == SPH_BP_EXTRAPOLATE) cv.bp_mode = SPH_BP_MIRROR;
