@@ -2129,7 +2129,7 @@ static size_t sph__neighbors_chunk(sph_neighbors* nl, const sph_grid* g, const s
 
 #if SPH__VN > 1
 /* The distance test of sph__neighbors_chunk_dense for candidates q .. qend - 1 of a row, several
-   at a time (SSE2; 2D in both precisions, 3D in double): each candidate is written at *m, and *m
+   at a time (SSE2; 2D and 3D in both precisions): each candidate is written at *m, and *m
    advances for those within the radius. r2 = (dx^2 + dy^2) + dz^2 as in the scalar loop, so the
    lists are the same. Returns the first candidate left to the scalar loop. */
 SPH__INLINE size_t sph__row_within(const sph_real* x, const sph_real* p, size_t q, size_t qend,
@@ -2147,6 +2147,21 @@ SPH__INLINE size_t sph__row_within(const sph_real* x, const sph_real* p, size_t 
             bits = _mm_movemask_ps(_mm_cmplt_ps(
                 _mm_add_ps(_mm_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0)),
                            _mm_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1))), vr));
+            out[mm] = (uint32_t)q; mm += (size_t)(bits & 1);
+            out[mm] = (uint32_t)(q + 1); mm += (size_t)((bits >> 1) & 1);
+            out[mm] = (uint32_t)(q + 2); mm += (size_t)((bits >> 2) & 1);
+            out[mm] = (uint32_t)(q + 3); mm += (size_t)((bits >> 3) & 1);
+        }
+    } else if (D == 3) { /* four candidates per test, their coordinates gathered by lane */
+        const __m128 vx = _mm_set1_ps(p[0]), vy = _mm_set1_ps(p[1]), vz = _mm_set1_ps(p[2]);
+        const __m128 vr = _mm_set1_ps(r2max);
+        for (; q + 4 <= qend; q += 4) {
+            const sph_real* xj = x + 3 * q;
+            const __m128 a = _mm_sub_ps(vx, _mm_setr_ps(xj[0], xj[3], xj[6], xj[9]));
+            const __m128 b = _mm_sub_ps(vy, _mm_setr_ps(xj[1], xj[4], xj[7], xj[10]));
+            const __m128 z = _mm_sub_ps(vz, _mm_setr_ps(xj[2], xj[5], xj[8], xj[11]));
+            bits = _mm_movemask_ps(_mm_cmplt_ps(
+                _mm_add_ps(_mm_add_ps(_mm_mul_ps(a, a), _mm_mul_ps(b, b)), _mm_mul_ps(z, z)), vr));
             out[mm] = (uint32_t)q; mm += (size_t)(bits & 1);
             out[mm] = (uint32_t)(q + 1); mm += (size_t)((bits >> 1) & 1);
             out[mm] = (uint32_t)(q + 2); mm += (size_t)((bits >> 2) & 1);

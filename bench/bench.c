@@ -8,7 +8,8 @@
                  baseline's agreement with sph.h after the same steps
      scaling     the same scenes on 1..P threads: speed-up, and whether the states are bitwise equal
      search      neighbour search alone: grid build and list build, ns per particle, vs baseline
-     float       WCSPH in float against double, same scene, interleaved repeats
+     float       WCSPH in float against double, same scene, interleaved repeats (step, and
+                 its neighbour search, density-rate and force passes)
      memory      bytes per particle: 2D single phase, 3D two phases, the baseline
      growth      time per step against N (10^3 .. 10^6 in 2D) per solver; fitted exponent
      model       the 2D dam break with one optional piece of physics on at a time: bytes, time
@@ -341,19 +342,30 @@ static int suite_float(const opts* o) {
         const int steps = o->steps ? o->steps
                                    : steps_for(o->n, solver_cost[0] * (dim == 3 ? 4 : 1),
                                                o->quick ? 0.25 : 2.0, 5, 200);
-        double td[16], tf[16], n = 0, md, mf;
+        /* the stages a step's time is mostly in, each the median over the repeats */
+        static const int stages[3] = {SPH_STAGE_NEIGHBORS, SPH_STAGE_DENSITY, SPH_STAGE_FORCES};
+        static const char* stage_names[3] = {"neighbours", "density rate", "forces"};
+        double td[16], tf[16], sd[3][16], sf[3][16], n = 0, md, mf;
         bench_result r;
+        int k;
         for (rep = 0; rep < o->repeats && rep < 16; ++rep) {
             if (!run_d(sc, BENCH_WCSPH, o->n, 5, steps, &r)) return 0;
             td[rep] = r.step_s;
+            for (k = 0; k < 3; ++k) sd[k][rep] = r.stage_s[stages[k]];
             n = r.n;
             if (!bench_run_f(sc, BENCH_WCSPH, o->n, 5, steps, &r)) return 0;
             tf[rep] = r.step_s;
+            for (k = 0; k < 3; ++k) sf[k][rep] = r.stage_s[stages[k]];
         }
         md = median(td, rep);
         mf = median(tf, rep);
         printf("%s, %.0f particles: double %.3f ms/step, float %.3f ms/step: float x%.2f\n",
                bench_scenes[sc].name, n, 1e3 * md, 1e3 * mf, md / mf);
+        for (k = 0; k < 3; ++k) {
+            const double a = median(sd[k], rep), b = median(sf[k], rep);
+            printf("    %-12s double %.3f ms, float %.3f ms: float x%.2f\n", stage_names[k],
+                   1e3 * a, 1e3 * b, b > 0 ? a / b : 0);
+        }
         fprintf(f, "%s,%.0f,%.6f,%.6f,%.3f\n", bench_scenes[sc].name, n, 1e3 * md, 1e3 * mf,
                 md / mf);
     }
