@@ -227,8 +227,8 @@ int main(void) {
    alpha_i (eq. 11, walls included), def.omega and def.warm_start, negative pressures clamped.
    w.p is the constant-density pressure; w.drho keeps the divergence solve's warm start between
    steps. A solve that ends at max_iterations above its tolerance finishes the step and returns
-   SPH_ERR_NOT_CONVERGED. All three boundary schemes work on open tanks (MIRROR and EXTRAPOLATE
-   run the divergence solve with mirrored walls: its pressure balances no weight); a fluid that
+   SPH_ERR_NOT_CONVERGED. Both wall schemes work on open tanks (EXTRAPOLATE runs the divergence
+   solve with mirrored walls: its pressure balances no weight); a fluid that
    fills a closed box is solved with zero wall pressure whatever the scheme (with walls that
    copy the fluid's pressure it has no pressure level: see sph__enclosed). Phases may differ in rest density and mass (summation
    density: ratios near 1). Measured (tests/test_dfsph.c, 2D dam break, 20 particles per a, the
@@ -248,10 +248,9 @@ int main(void) {
    particle's own rest density. Free slip (default) leaves walls out of the viscous terms;
    no-slip uses Adami's extrapolated wall velocity. Boundary particles can move: see callbacks.
    def.boundary_pressure picks how the fluid sees a wall's pressure: automatic (default: zero for
-   IISPH and DFSPH, extrapolated for the others), extrapolated (the only one that fits WCSPH),
-   mirrored (p_b = p_i; dp/dn = 0 at the wall, so hydrostatic pressure comes out steep) or zero
-   (the wall-adjacent layer carries the load; with WCSPH and no wall contact particles got
-   through). Why zero for the
+   IISPH and DFSPH, extrapolated for the others), extrapolated (the only one that fits WCSPH) or
+   zero (the wall-adjacent layer carries the load; with WCSPH and no wall contact particles got
+   through). Mirrored (p_b = p_i) is refused (SPH_ERR_ARG), see below. Why zero for the
    incompressible solvers: IISPH and DFSPH (and PCISPH) hold the summation-density constraint C_i =
    rho_i / rho0 - 1 = 0, where rho_i includes the walls' psi_b W_ib, and their pressure force is
    the constraint force -sum_i lambda_i grad C_i (lambda_i ~ p_i / rho_i^2). Its wall part on
@@ -261,12 +260,27 @@ int main(void) {
    add -psi_b (p_b / rho_b^2) grad W_ib, which is not the gradient of any constraint: it does work
    whenever a particle moves towards or away from a wall while its pressure changes within the
    step, and near a floor that work is positive on average (a particle that compresses into the
-   wall layer leaves it faster than it came). Measured with IISPH and mirrored walls on a 2D tank
-   at rest (1 x 0.8 m of water, dx 0.04, sph_advance with the defaults): kinetic energy 1.4 J after
-   0.05 s, 128 J after 1.2 s, wall-layer particles bouncing at 2-4 m/s (tests/test_scenes.c, make
-   validate, prints every scheme's outcome). The zero scheme's price: a particle at a corner feels
-   little wall push until its pressure rises, so the first steps from sph_set_hydrostatic pull the
-   corners in (3D tank, dx 0.04: kinetic energy 0.9 J after 0.05 s against 0.016 J with
+   wall layer leaves it faster than it came). Mirroring doubles the wall term of particle i with
+   its own pressure: the force on i is then -p_i/rho_i^2 grad(rho_f,i + 2 rho_w,i), with rho_w,i =
+   sum_b psi_b W_ib, while the pressure holds rho_f,i + rho_w,i. Its work around a closed path,
+   the integral of (p_i / rho_i^2) grad rho_w,i . dx, vanishes only where p_i / rho_i^2 is a
+   function of rho_w,i alone, so it is not conservative in any solver, explicit or implicit:
+   with gravity (pressure growing with depth) a particle circulating in a corner gains energy
+   each turn. Measured on a 2D tank at rest
+   (1 x 0.8 m of water in a 1 m box, dx 0.04, sph_advance, 1.5 s): the kinetic energy climbed to
+   0.3 % (WCSPH) and 0.6 % (IISPH) of rho g H^2 per metre of tank, the water moving at 0.3-0.44
+   sqrt(g H), where zero walls settled to 0.05 sqrt(g H); the 3D tank gained 3-7 % with every
+   incompressible solver (make validate's long/scenes/schemes_*, before the scheme was refused).
+   Making the solve consistent with the doubled wall term (IISPH's a_ii and A p counting the walls
+   twice) only slowed the gain (largest rise 0.0047 against 0.012 of rho g H^2 within 1.5 s, the
+   water still moving at 0.34 sqrt(g H)). So sph_world_init and every step refuse SPH_BP_MIRROR
+   with SPH_ERR_ARG and say why; DFSPH's divergence solve still uses the mirror internally, where
+   its pressure balances no weight (see >>dfsph). Extrapolated walls add the same kind of term,
+   weighted by the wall's share of the fluid around it; it is small where the pressure is smooth
+   (tanks at rest: energy rise at most 5.1e-4 of rho g H^2 in the scenes of tests/test_scenes.c),
+   and IISPH, DFSPH and PCISPH drop it in a fluid that fills its walls (sph__enclosed). The zero
+   scheme's price: a particle at a corner feels little wall push until its pressure rises, so
+   the first steps from sph_set_hydrostatic pull the corners in (3D tank, dx 0.04: kinetic energy 0.9 J after 0.05 s against 0.016 J with
    extrapolated walls), and the tank comes to rest more slowly. def.boundary_volume =
    SPH_BVOL_AKINCI recomputes each wall particle's volume from the wall particles around it
    whenever walls move (Akinci et al. 2012), for single-layer and non-uniformly sampled walls; with
@@ -765,8 +779,11 @@ typedef enum sph_pressure_solve {
 typedef enum sph_boundary_pressure {
     SPH_BP_EXTRAPOLATE = 0, /* Adami et al. 2012: p_b from the fluid with body force and wall
                                acceleration (WCSPH's and the compressible step's default)      */
-    SPH_BP_MIRROR,          /* p_b = p_i, rho_b = rho_i (Koschier et al. 2020); gains energy
-                               with the incompressible solvers (tests/test_scenes.c)          */
+    SPH_BP_MIRROR,          /* p_b = p_i, rho_b = rho_i (Koschier et al. 2020): REJECTED with
+                               SPH_ERR_ARG by sph_world_init and every step. Its wall force is
+                               no constraint force and not conservative, and it put energy into
+                               a tank at rest with every solver (see BOUNDARIES); kept so that
+                               code naming it compiles and gets the reason                    */
     SPH_BP_ZERO,            /* p_b = 0 (Akinci et al. 2012 as used by Ihmsen et al. 2014; Bender
                                & Koschier 2017): IISPH's and DFSPH's default                  */
     SPH_BP_AUTO             /* (the default of sph_world_def_default) resolved by
@@ -2739,6 +2756,15 @@ static sph_status sph__fail_far(sph_world* w, sph_real dx, long index, const cha
 #define SPH__CHECK(cond, ...)                                                                      \
     do { if (!(cond)) return sph__fail(w, SPH_ERR_ARG, -1, __VA_ARGS__); } while (0)
 
+/* Why SPH_BP_MIRROR is refused (derived in BOUNDARIES): measured on a 2D tank at rest (1 x 0.8 m
+   of water in a 1 m box, dx 0.04, sph_advance with frames of 0.05 s, 1.5 s) it kept the water
+   moving at 0.3-0.44 sqrt(g H) with the kinetic energy climbing to 0.3 % (WCSPH) and 0.6 % (IISPH)
+   of rho g H^2 per metre of tank, where extrapolated and zero walls come to rest. */
+static const char sph__mirror_rejected[] =
+    "boundary_pressure = SPH_BP_MIRROR: mirrored wall pressure (p_b = p_i) is not a conservative "
+    "force and puts energy into a fluid at rest with every solver; use SPH_BP_AUTO (the "
+    "default), SPH_BP_EXTRAPOLATE or SPH_BP_ZERO";
+
 static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
     int k;
     SPH__CHECK(d->dim >= 1 && d->dim <= 3, "sph_world_def.dim = %d: must be 1, 2 or 3", d->dim);
@@ -2758,6 +2784,7 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
     SPH__CHECK((int)d->boundary_pressure >= 0 && d->boundary_pressure <= SPH_BP_AUTO,
                "sph_world_def.boundary_pressure = %d: not a sph_boundary_pressure",
                (int)d->boundary_pressure);
+    SPH__CHECK(d->boundary_pressure != SPH_BP_MIRROR, "sph_world_def.%s", sph__mirror_rejected);
     SPH__CHECK((int)d->boundary_volume >= 0 && d->boundary_volume <= SPH_BVOL_AKINCI,
                "sph_world_def.boundary_volume = %d: not a sph_boundary_volume",
                (int)d->boundary_volume);
@@ -5503,6 +5530,8 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
                 return sph__fail(w, SPH_ERR_ARG, -1,
                                  "step: phase %d has a gas equation of state, which needs the "
                                  "internal energy only sph_step_compressible evolves", k);
+    if (w->def.boundary_pressure == SPH_BP_MIRROR) /* w.def changed after sph_world_init */
+        return sph__fail(w, SPH_ERR_ARG, -1, "step: w.def.%s", sph__mirror_rejected);
     s = sph__check_step_input(w, dt);
     if (s != SPH_OK) return s;
     /* scratch first, so that running out of memory here changes nothing */
@@ -7019,7 +7048,8 @@ SPHDEF sph_status sph_step_iisph(sph_world* w, sph_real dt) {
    pressure pass and one cached continuity pass, as an IISPH iteration does.
    Boundary schemes: ZERO (p_b = 0, k_b = 0) is Akinci et al.'s boundary as Bender & Koschier use
    it: the wall pushes with the fluid particle's own kappa_i. MIRROR (p_b = p_i, rho_b = rho_i,
-   k_b = 1) doubles that push. EXTRAPOLATE: the constant-density solve extrapolates Adami's p_b
+   k_b = 1) doubles that push; users cannot choose it (see BOUNDARIES), the divergence solve
+   uses it internally (below). EXTRAPOLATE: the constant-density solve extrapolates Adami's p_b
    from the fluid's p (with the body force and the wall's acceleration, k_b = W_bi / sum_f W_bf
    rho_i^2 / rho_b^2); the divergence solve's p^v balances no weight, so its wall condition is
    dp^v/dn = 0, whose per-pair form is the mirror: EXTRAPOLATE runs the divergence solve as MIRROR

@@ -138,16 +138,19 @@ static void test_iterations_grow(void) {
     CHECK(itt[0] < itt[1] && itt[1] < itt[2]);
 }
 
-/* The three boundary pressure schemes hold a tank at rest: no particle passes a wall in 4 s and
-   the compression stays at 0.1 % (extrapolation) or within 0.2 %. Meiers 2025 sec. 5.3: zero
+/* The boundary pressure schemes hold a tank at rest: no particle passes a wall in 4 s and the
+   compression stays at 0.1 % (extrapolation) or within 0.2 %. Meiers 2025 sec. 5.3: zero
    pressure puts the weight on the wall-adjacent layer (its pressure runs well above hydrostatic),
-   mirroring and extrapolation do not. The wall-adjacent pressure errors are reported. */
+   extrapolation does not. The wall-adjacent pressure errors are reported. Mirroring (p_b = p_i,
+   +1.4 % next to the floor here when it was offered) is refused: it put energy into tanks at rest
+   (see SPH_BP_MIRROR). */
 static void test_boundary_schemes(void) {
     static const char* names[3] = {"extrapolation", "mirroring", "zero pressure"};
     tank_result r[3];
     int bp;
     for (bp = 0; bp < 3; ++bp) {
         sph_world_def def = sph_world_def_default(2);
+        if (bp == SPH_BP_MIRROR) continue;
         def.boundary_pressure = (sph_boundary_pressure)bp;
         r[bp] = run_tank(def, 0.5, 0, 0, 0.005, 4.0, 3);
         TH_NOTE("%-13s: near-floor pressure error %+.4f, interior layers %.4f of rho g H, "
@@ -160,7 +163,6 @@ static void test_boundary_schemes(void) {
     }
     CHECK_LT(0.1, r[2].near_floor);                  /* zero pressure overloads the wall layer */
     CHECK_LT(fabs(r[0].near_floor), 0.05);
-    CHECK_LT(fabs(r[1].near_floor), 0.05);
 }
 
 /* Single-layer walls with Akinci volumes, closed box: after the start (a single layer with
@@ -171,6 +173,7 @@ static void test_single_layer_walls(void) {
     for (bp = 0; bp < 3; ++bp) {
         sph_world_def def = sph_world_def_default(2);
         tank_result r;
+        if (bp == SPH_BP_MIRROR) continue; /* refused (see SPH_BP_MIRROR) */
         /* through sph_advance: at a fixed 5 ms a particle reached 5.5 m/s at t = 0.37 s with
            zero wall pressure, which the step now reports (1.09 spacings per step) */
         def.boundary_pressure = (sph_boundary_pressure)bp;

@@ -150,10 +150,10 @@ static void test_hydrostatic_linear_eos(void) {
 }
 
 /* The boundary pressure schemes of the iterative solvers are available to WCSPH too, with the
-   same walls, but only extrapolation fits a pressure that follows the density. Mirroring sets
-   dp/dn = 0 at the wall where hydrostatics needs rho g . n: the tank holds, but its pressure is
-   further from hydrostatic than with extrapolation (1.7 times measured in double, 7 times in
-   float: the settled state depends on the run). Zero pressure cannot
+   same walls, but only extrapolation fits a pressure that follows the density. Mirroring (p_b =
+   p_i, now refused: see SPH_BP_MIRROR) set dp/dn = 0 at the wall where hydrostatics needs
+   rho g . n: its pressure was 1.7 (double) to 7 (float) times further from hydrostatic than
+   extrapolation's. Zero pressure cannot
    balance the push of the fluid above the wall-adjacent layer until the layer is compressed:
    without the wall contact (def.wall_contact) particles got through the floor (4 counted, and
    the run failed at t = 0.47 s naming one inside the wall). With it (the default) the floor
@@ -162,13 +162,8 @@ static void test_hydrostatic_boundary_schemes(void) {
     sph_world_def def = sph_world_def_default(2);
     const hs_result ex = run_hydrostatic(def, SPH_EOS_TAIT, 20, 1.5, 0.5);
     hs_result r;
-    def.boundary_pressure = SPH_BP_MIRROR;
-    r = run_hydrostatic(def, SPH_EOS_TAIT, 20, 1.5, 0.5);
-    TH_NOTE("WCSPH, mirrored walls: pressure error mean %.4f max %.4f of rho g H (extrapolated "
-            "walls %.4f), slope %.4f, outside %zu", r.err_mean, r.err_max, ex.err_mean, r.slope,
-            r.outside);
-    CHECK_EQ_INT(r.outside, 0);
-    CHECK_LT(ex.err_mean, r.err_mean);
+    TH_NOTE("WCSPH, extrapolated walls: pressure error mean %.4f max %.4f of rho g H",
+            ex.err_mean, ex.err_max);
     def.boundary_pressure = SPH_BP_ZERO;
     r = run_hydrostatic(def, SPH_EOS_TAIT, 20, 1.5, 0.5);
     TH_NOTE("WCSPH, zero-pressure walls: pressure error mean %.4f max %.4f of rho g H, %zu "

@@ -87,6 +87,11 @@ static void test_def_fields(void) {
         {"cfl", 14, 0},         {"cfl", 14, 1.5},        {"cfl_viscous", 15, 0},
         {"cfl_force", 16, -1},  {"max_compression", 17, -0.5},
         {"max_speed", 18, -1},  {"domain_lo/hi", 19, 0}, {"periodic", 20, 0},
+        /* mirrored wall pressure is refused with every solver (not conservative: it put energy
+           into tanks at rest, see SPH_BP_MIRROR in sph.h) */
+        {"boundary_pressure", 21, SPH_SOLVER_WCSPH}, {"boundary_pressure", 21, SPH_SOLVER_PCISPH},
+        {"boundary_pressure", 21, SPH_SOLVER_IISPH}, {"boundary_pressure", 21, SPH_SOLVER_DFSPH},
+        {"boundary_pressure", 21, SPH_SOLVER_COMPRESSIBLE},
     };
     size_t c;
     (void)nan_;
@@ -119,6 +124,7 @@ static void test_def_fields(void) {
         case 19: d.domain_lo[0] = 1; d.domain_hi[0] = 0; break;
         case 20: /* periodic box shorter than two kernel supports */
             d.periodic[0] = 1; d.domain_lo[0] = 0; d.domain_hi[0] = d.spacing * 3; break;
+        case 21: d.solver = (sph_solver)(int)v; d.boundary_pressure = SPH_BP_MIRROR; break;
         }
         s = sph_world_init(&w, &d);
         CHECK_MSG(s == SPH_ERR_ARG, "def.%s = %g accepted (status %d)", cases[c].field, v, (int)s);
@@ -347,6 +353,16 @@ static void test_bad_step_input(void) {
     CHECK_EQ_INT(th_step(&w, 1e-4), SPH_ERR_ARG);
     CHECK(strstr(w.error, "velocity") != NULL);
     w.v[2 * 3] = keep;
+    CHECK(snap_same(&s, &w));
+    /* a wall scheme the library refuses, set in w.def after sph_world_init */
+    {
+        const sph_boundary_pressure bp = w.def.boundary_pressure;
+        w.def.boundary_pressure = SPH_BP_MIRROR;
+        CHECK_EQ_INT(th_step(&w, 1e-4), SPH_ERR_ARG);
+        CHECK(strstr(w.error, "SPH_BP_MIRROR") != NULL);
+        CHECK_EQ_INT(sph_advance(&w, (sph_real)1e-3), SPH_ERR_ARG);
+        w.def.boundary_pressure = bp;
+    }
     CHECK(snap_same(&s, &w));
     CHECK_EQ_INT(sph_add_fluid(&w, ph, 1, xbad, NULL), SPH_ERR_ARG);
     CHECK_EQ_INT(sph_add_fluid(&w, ph, 1, xok, vbad), SPH_ERR_ARG);
