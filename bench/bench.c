@@ -28,7 +28,9 @@
                  wall-clock seconds (it reports the time it reached)
    Options: --quick (small sizes, < 1 minute), --out DIR (CSV and SVG; default bench/results),
             --n N, --scene S, --solver S, --threads T, --repeats R, --steps K, --t-end T (tts:
-            simulated seconds, default 1), --max-wall S, --precision double|float|all
+            simulated seconds, default 1), --max-wall S, --precision double|float|all,
+            --kernel default|cubic (tts: the cubic B-spline at h = dx and omega 0.5 instead of
+            the default kernel, the peer's support)
    Every timing is the median over the repeats of a wall-clock time per step; runs that are
    compared (ours against the baseline, double against float) alternate inside one repeat loop,
    so a slow minute on a shared machine hits both. tts is the exception: one run per cell (each
@@ -49,6 +51,8 @@
 int bench_run_f(int scene, int solver, double target, int warm, int steps, bench_result* r);
 int bench_tts_f(int scene, int solver, int quick, double t_end, double max_wall, double progress,
                 tts_result* r);
+
+int bench_tts_kernel = 0;
 
 typedef struct opts {
     int quick, repeats, steps, threads, threads_set, scene, solver;
@@ -597,7 +601,7 @@ static int suite_tts(const opts* o) {
     FILE* f = csv_open(o, "tts.csv",
                        "scene,solver,precision,threads,fluid,walls,t_end,time_reached,status,"
                        "wall_s,s_per_sim_s,frames,substeps,retries,dt_mean,dt_min,iters_mean,"
-                       "err_mean,comp_mean,comp_max,outside_max,outside_depth_dx,capped,load1,error");
+                       "err_mean,comp_mean,comp_max,outside_max,outside_depth_dx,capped,load1,kernel,error");
     if (!f) return 0;
     if (o->threads_set)
         threads[nthreads++] = o->threads;
@@ -613,8 +617,9 @@ static int suite_tts(const opts* o) {
             Y[sc][sv] = NAN;
         }
     printf("\n== time to solution: sph_advance with the library's defaults, frames of %.2f s, to "
-           "t = %.2f s; %d processor(s)\n",
-           TTS_FRAME, t_end, P);
+           "t = %.2f s; %d processor(s)%s\n",
+           TTS_FRAME, t_end, P,
+           bench_tts_kernel ? "; --kernel cubic: cubic B-spline, h = dx, omega 0.5" : "");
     for (sc = 0; sc < TTS_NSCENE; ++sc)
         if (scenes >> sc & 1) printf("  %-7s %s\n", tts_scene_names[sc], tts_scene_what[sc]);
     printf("  s/sim-s: wall-clock seconds per simulated second (inside sph_advance); comp: mean "
@@ -657,7 +662,7 @@ static int suite_tts(const opts* o) {
                     fflush(stdout);
                     fprintf(f,
                             "%s,%s,%s,%d,%.0f,%.0f,%.4f,%.6f,%s,%.3f,%.6g,%d,%.0f,%.0f,%.6g,%.6g,"
-                            "%.2f,%.6g,%.6g,%.6g,%.0f,%.3f,%d,%.2f,\"",
+                            "%.2f,%.6g,%.6g,%.6g,%.0f,%.3f,%d,%.2f,%s,\"",
                             tts_scene_names[sc], tts_solver_names[sv], pr ? "float" : "double",
                             threads[ti], r->n, r->nb, t_end, r->time,
                             r->status > 0   ? sph_status_string((sph_status)r->status)
@@ -666,7 +671,8 @@ static int suite_tts(const opts* o) {
                             r->wall_s, rt, r->frames, r->substeps, r->retries,
                             r->substeps > r->retries ? r->time / (r->substeps - r->retries) : 0,
                             r->dt_min, r->its_mean, r->err_mean, r->comp_mean, r->comp_max,
-                            r->outside_max, r->outside_depth, r->capped, load_average());
+                            r->outside_max, r->outside_depth, r->capped, load_average(),
+                            bench_tts_kernel ? "cubic" : "default");
                     for (c = r->error; *c; ++c) /* the message, CSV-quoted */
                         if (*c == '"')
                             fputs("\"\"", f);
@@ -780,6 +786,16 @@ int main(int argc, char** argv) {
             o.t_end = atof(v);
         else if (strcmp(a, "--max-wall") == 0)
             o.max_wall = atof(v);
+        else if (strcmp(a, "--kernel") == 0) {
+            if (strcmp(v, "default") == 0)
+                bench_tts_kernel = 0;
+            else if (strcmp(v, "cubic") == 0)
+                bench_tts_kernel = 1;
+            else {
+                fprintf(stderr, "bench: unknown --kernel %s (default, cubic)\n", v);
+                return 2;
+            }
+        }
         else if (strcmp(a, "--precision") == 0) {
             if (!(o.precisions = name_mask(v, precisions, 2))) {
                 fprintf(stderr, "bench: unknown precision %s (double, float, double,float, all)\n",

@@ -417,6 +417,11 @@ BENCH_FN int BX(tts_build)(sph_world* w, int scene, int solver, int quick) {
     default:
         break;
     }
+    if (bench_tts_kernel == 1) { /* --kernel cubic: the peer's support, 2 dx */
+        def.kernel = SPH_KERNEL_CUBIC;
+        def.h_factor = 1;
+        def.omega = (sph_real)0.5;
+    }
     if (scene == TTS_DAM2D) { /* examples/dambreak.c's scene: a = 0.5 m, 40 particles per a */
         const double a = 0.5;
         def.domain_hi[0] = (sph_real)(5 * a);

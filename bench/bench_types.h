@@ -64,6 +64,11 @@ static const char* const tts_solver_names[TTS_NSOLVER] = {"wcsph", "pcisph-enh",
 
 #define TTS_FRAME 0.02 /* one frame, 1/50 s: the duration of each sph_advance call */
 
+/* tts --kernel: 0 the library's default (Wendland C2, h = 1.3 dx), 1 the cubic B-spline at
+   h = dx with the Jacobi weight 0.5 in 3D (support 2 dx: 33 neighbours in 3D against 74, the
+   peer's kernel; see README "Time to solution"). Defined in bench.c, read by both precisions. */
+extern int bench_tts_kernel;
+
 typedef struct tts_result {
     double n, nb;          /* fluid and wall particles                                          */
     double time;           /* simulated time reached [s]                                        */
