@@ -280,12 +280,17 @@ int main(void) {
    (tanks at rest: energy rise at most 5.1e-4 of rho g H^2 in the scenes of tests/test_scenes.c),
    and IISPH, DFSPH and PCISPH drop it in a fluid that fills its walls (sph__enclosed). The zero
    scheme's price: a particle at a corner feels little wall push until its pressure rises, so
-   the first steps from sph_set_hydrostatic pull the corners in (3D tank, dx 0.04: kinetic energy 0.9 J after 0.05 s against 0.016 J with
-   extrapolated walls), and the tank comes to rest more slowly. def.boundary_volume =
-   SPH_BVOL_AKINCI recomputes each wall particle's volume from the wall particles around it
-   whenever walls move (Akinci et al. 2012), for single-layer and non-uniformly sampled walls; with
-   boundary_gamma = 1 a flat single layer weighs about three layers, so the fluid keeps a little
-   off it but cannot leak through.
+   the first steps from sph_set_hydrostatic pull the corners in (3D tank, dx 0.04: kinetic
+   energy 0.9 J after 0.05 s against 0.016 J with extrapolated walls), and the tank comes to rest
+   more slowly. def.boundary_volume = SPH_BVOL_AKINCI recomputes each wall particle's volume from
+   the wall particles around it whenever walls move (Akinci et al. 2012), for single-layer and
+   non-uniformly sampled walls, scaled by gamma_1 (def.boundary_gamma), by default the value that
+   gives the fluid beside a flat single layer its rest density (sph__akinci_gamma; 0.585 for the
+   default kernel). With gamma_1 = 1 (the default before) such a layer weighed 1.7 half spaces:
+   the fluid a host placed beside it started 15-30 % compressed, IISPH, DFSPH and the original
+   PCISPH refused their first step, and the others turned the compression into motion. Particles
+   that reach the lighter layer's line do not pass between its particles: the wall contact below
+   keeps them off (tests/test_scenes.c: single-layer ring and box walls, 2D and 3D).
    Wall contact (def.wall_contact, on by default): no pressure scheme stops a particle that is
    short of fluid neighbours (a splash, the one-particle sheet a dam break spreads along the floor)
    from sinking until the wall supplies the volume it lacks, i.e. onto and past the wall's first
@@ -800,11 +805,10 @@ typedef enum sph_boundary_volume {
     SPH_BVOL_GIVEN = 0, /* as added (dx^dim, or the array given to sph_add_boundary) (default) */
     SPH_BVOL_AKINCI     /* V_b = gamma / sum_b' W_bb' over wall neighbours, recomputed whenever
                            walls move (Akinci et al. 2012): for single-layer and irregularly
-                           sampled walls (lattice walls of several layers keep GIVEN). With
-                           gamma = 1 and h = 1.3 dx a flat single layer weighs about three
-                           layers: the fluid stands a little off it, but cannot leak through;
-                           a gamma that matches the rest density (about 0.58) lets particles
-                           that reach the layer's line pass between its particles            */
+                           sampled walls (lattice walls of several layers keep GIVEN). gamma
+                           (def.boundary_gamma) is by default the one that gives a fluid
+                           lattice its rest density beside a flat single layer
+                           (sph__akinci_gamma: 0.585 for Wendland C2 at h = 1.3 dx)           */
 } sph_boundary_volume;
 
 typedef enum sph_wall {
@@ -904,8 +908,10 @@ typedef struct sph_world_def {
     sph_wall wall;             /* default SPH_WALL_FREE_SLIP                                      */
     sph_boundary_pressure boundary_pressure; /* default SPH_BP_AUTO (see there)                   */
     sph_boundary_volume boundary_volume;     /* default SPH_BVOL_GIVEN                            */
-    sph_real boundary_gamma;   /* Akinci volume factor gamma_1 (Meiers 2025 eq. 27) [-]; default 1;
-                                  (0, 10]; used with SPH_BVOL_AKINCI only                        */
+    sph_real boundary_gamma;   /* Akinci volume factor gamma_1 (Meiers 2025 eq. 27) [-]; default 0:
+                                  calibrated by sph_world_init (w.def holds the value) so that
+                                  a flat single layer at spacing dx gives the fluid lattice
+                                  beside it the rest density; else (0, 10]; SPH_BVOL_AKINCI only */
     sph_real cfl;              /* acoustic CFL number for sph_stable_dt (WCSPH, compressible; also
                                   PCISPH's delta-SPH speed cfl h / dt); default 0.25; (0, 1]     */
     sph_real cfl_viscous;      /* viscous limit dt <= cfl_viscous h^2 / nu (0.8 of it for
@@ -2668,7 +2674,7 @@ SPHDEF sph_world_def sph_world_def_default(int dim) {
     d.max_substeps = 100000;
     d.boundary_pressure = SPH_BP_AUTO;
     d.boundary_volume = SPH_BVOL_GIVEN;
-    d.boundary_gamma = 1;
+    d.boundary_gamma = 0; /* calibrated by sph_world_init (sph__akinci_gamma) */
     d.cfl_velocity = SPH__R(0.4); /* Meiers 2025 eq. 14 */
     d.tolerance = SPH__R(0.001);  /* 0.1 % mean compression, Meiers 2025 */
     d.min_iterations = 2;
@@ -2788,9 +2794,10 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
     SPH__CHECK((int)d->boundary_volume >= 0 && d->boundary_volume <= SPH_BVOL_AKINCI,
                "sph_world_def.boundary_volume = %d: not a sph_boundary_volume",
                (int)d->boundary_volume);
-    SPH__CHECK(sph__finite((double)d->boundary_gamma) && d->boundary_gamma > 0 &&
+    SPH__CHECK(sph__finite((double)d->boundary_gamma) && d->boundary_gamma >= 0 &&
                    d->boundary_gamma <= 10,
-               "sph_world_def.boundary_gamma = %g: must be in (0, 10]", (double)d->boundary_gamma);
+               "sph_world_def.boundary_gamma = %g: must be 0 (calibrated) or in (0, 10]",
+               (double)d->boundary_gamma);
     SPH__CHECK(sph__finite((double)d->cfl_velocity) && d->cfl_velocity > 0 && d->cfl_velocity <= 1,
                "sph_world_def.cfl_velocity = %g: must be in (0, 1]", (double)d->cfl_velocity);
     SPH__CHECK(sph__finite((double)d->max_dt) && d->max_dt >= 0,
@@ -2922,6 +2929,37 @@ static sph_real sph__wall_fraction_limit(const sph_kernel* k, sph_real dx) {
     return (sph_real)(sum * vol);
 }
 
+/* The Akinci volume factor gamma_1 that makes a flat single layer of wall particles at spacing
+   dx stand in for the wall's half space: a fluid particle in the first row of a lattice, 1 dx
+   from the layer (where sph_fill_box and a host's lattice put it), then sums to the rest
+   density,
+       F + gamma V_1 sum_b W_ib = S,   V_1 = S / sum_b' W_bb'  (gamma = 1's volume),
+   F the fluid half lattice's sum (its own row included), S the full lattice's, sums over the
+   layer's particles in the plane (line in 2D) 1 dx away and within the layer. With gamma = 1
+   (Akinci et al. 2012's volumes as they stand) that layer weighs 1.7 half spaces for Wendland
+   C2 at h = 1.3 dx: the fluid beside a single layer started 15 % compressed (24 % at a corner
+   of host-placed walls), which IISPH, DFSPH and the original PCISPH refused at their first step
+   (max_compression) and, allowed to run, turned into kinetic energy (a tilted tank dam break,
+   dx 0.02: energy rise 12-49 % of M g H). Values: 0.585 (2D) and 0.587 (3D) for Wendland C2 at
+   h = 1.3 dx, 0.68 / 0.70 for the cubic B-spline at h = dx. */
+static sph_real sph__akinci_gamma(const sph_kernel* k, sph_real dx) {
+    const int R = (int)(k->radius / dx) + 1, D = k->dim;
+    double full = 0, half = 0, line = 0, wall = 0;
+    int i, j, l;
+    for (i = -R; i <= R; ++i) /* i: the direction normal to the layer */
+        for (j = (D > 1 ? -R : 0); j <= (D > 1 ? R : 0); ++j)
+            for (l = (D > 2 ? -R : 0); l <= (D > 2 ? R : 0); ++l) {
+                const double r = sqrt((double)(i * i + j * j + l * l)) * (double)dx;
+                const double W = (double)sph_kernel_w(k, (sph_real)r);
+                full += W;
+                if (i >= 0) half += W;
+                if (i == 0) line += W;
+                if (i == -1) wall += W;
+            }
+    /* (S - F) / (V_1 sum W_ib) with V_1 = S / line: the lattice volume dx^dim cancels */
+    return wall > 0 ? (sph_real)((full - half) * line / (full * wall)) : 1;
+}
+
 SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
     sph_status s;
     sph_real hf, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
@@ -2955,6 +2993,7 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
                          "not finite and > 0 in sph_real", (double)def->spacing, (double)w->h);
     w->priv.lattice_sum = sph__lattice_sum(&w->kernel, w->dx);
     w->priv.wall_fraction_max = sph__wall_fraction_limit(&w->kernel, w->dx) / w->priv.lattice_sum;
+    if (def->boundary_gamma == 0) w->def.boundary_gamma = sph__akinci_gamma(&w->kernel, w->dx);
     {
         const int R = (int)(w->kernel.radius / w->dx) + 1, D = def->dim;
         int i, j, l;
