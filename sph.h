@@ -192,8 +192,9 @@ int main(void) {
    light particle at an interface take its heavy neighbours' masses (the tests show the 0.2 tank
    failing with it and holding with particle density). The original PCISPH cannot hold two phases
    of different density at all (summation smears the mass jump): it fails within a few steps and
-   says so. Large first steps from rest need def.max_dt (the original restarts every step from
-   zero pressure). delta-SPH uses c = cfl h / dt, the speed for which dt is the acoustic step.
+   says so. The original's step is also bounded by its largest pressure, dt <= 0.25 h /
+   sqrt(p_max / rho0): its correction at the predicted positions diverges above (derived in
+   sph_stable_dt). delta-SPH uses c = cfl h / dt, the speed for which dt is the acoustic step.
 
    SOLVER: IISPH (sph_step_iisph, or def.solver = SPH_SOLVER_IISPH)
    Implicit incompressible SPH (Ihmsen et al. 2014; Meiers 2025): summation density, then a pressure
@@ -1278,7 +1279,9 @@ SPHDEF void sph_world_momentum(const sph_world* w, double* out);
    largest non-pressure acceleration: a step from rest is limited too); then the viscous and
    force limits (the incompressible solvers' at 0.4 cfl_force sqrt(h / |a|) with the non-pressure
    |a|: a pressure that enforces incompressibility grows like 1 / dt, and limiting the step by it
-   feeds back) and def.max_dt (see their fields). Fills in automatic sound
+   feeds back); for the original PCISPH (summation density) also 0.25 h / sqrt(p_max / rho0)
+   with its largest pressure now, or h / (32 |v|max) before any pressure (derived in the code);
+   and def.max_dt (see their fields). Fills in automatic sound
    speeds. Fails (SPH_ERR_ARG) for an unknown solver, when WCSPH or the compressible step lacks a
    sound speed it cannot choose, when WCSPH has no sound speed at all (e.g. no particles yet), or
    when nothing limits the step; SPH_ERR_UNSTABLE when the step rounds to 0 (e.g. |v| near the
@@ -7512,6 +7515,42 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver) {
     if (amax > 0)
         dt = fmin(dt, (sph__incompressible((int)solver) ? 0.4 : 1.0) * (double)w->def.cfl_force *
                           sqrt((double)w->h / amax));
+    /* The original PCISPH (summation density) corrects at the predicted positions x* = x + dt v +
+       dt^2 (a_np + a_p), which every correction moves: the pressure acceleration's derivative with
+       respect to position, about p / (rho0 h^2), feeds each correction back into the next with a
+       factor of about dt^2 p / (rho0 h^2), and once the pressure the correction has built brings
+       it to 0.3-0.8, a mode of neighbours a spacing apart grows, the gain guard cuts the gain and
+       the step fails. The force and velocity limits above do not see it (both failures the tests
+       met were at steps they allowed). Measured: the dam break of tests/test_pcisph.c (dx = 5 mm)
+       at the force limit's 2.45 ms: restarted from p = 0 (Alg. 5) each step with its mean error
+       below the tolerance, the column fell for three steps on a fraction of its weight (largest
+       pressure 380 Pa), then the fourth step's correction rebuilt 5600 Pa (3 rho0 g 2a) over 34
+       iterations and diverged at 0.8 (8.6 m/s); the periodic box of random velocities of
+       tests/test_reliability.c (0.34 m/s, dx = 0.02, no gravity, a solve that never converges at
+       1e-4, so its pressure level climbs) diverged at dt = 8 and 6 ms once that level reached 3800
+       and 6000 Pa (0.36 and 0.32) and ran at 4 ms and below. The enhanced variant (continuity
+       density) takes the pressure at x^n: no such feedback. The rule: dt^2 p_max / (rho0 h^2) <=
+       1/16 with the largest pressure now (the last step's, or sph_set_hydrostatic's): dt <= 0.25 h
+       / sqrt(p_max / rho0), a margin of 5-13 in dt^2 p for a step that builds more than its
+       predecessor did. Before any pressure (a first step without sph_set_hydrostatic) the pressure
+       that stops a relative velocity of up to 2 |v|max over h within the step, rho0 h 2 |v|max /
+       dt, in the same bound: dt <= h / (16 * 2 |v|max) (the periodic box: 2.4 ms). It is the force
+       limit of the pressure acceleration p / (rho0 h) at 0.25: a pressure that removes a density
+       error eps within the step (eps rho0 h^2 / dt^2) shrinks the next step only for eps > 1/16.
+       With it the dam break runs at 0.85 ms on average and the periodic box at 1.5-12 ms without a
+       failure; sph_advance's scenes (tests/test_scenes.c) take 23 % fewer (2D box) to 60 % more
+       (3D dam) steps with fewer retries (2D tank 669 steps and 93 retries before, 707 and 50 now;
+       2D slosh 288 and 40, 332 and 4), and the 2D tank's late speed rose from 0.045 to 0.088
+       sqrt(g H). */
+    if (solver == SPH_SOLVER_PCISPH && w->def.density == SPH_DENSITY_SUMMATION) {
+        double pr = 0;
+        for (i = 0; i < w->n; ++i) {
+            const double r = (double)w->p[i] / (double)w->phases[w->phase[i]].rest_density;
+            if (r > pr) pr = r;
+        }
+        if (pr > 0) dt = fmin(dt, 0.25 * (double)w->h / sqrt(pr));
+        else if (v2max > 0) dt = fmin(dt, (double)w->h / (16 * 2 * sqrt(v2max)));
+    }
     if (w->def.max_dt > 0) dt = fmin(dt, (double)w->def.max_dt);
     if (dt >= 1e300) {
         sph__fail(w, SPH_ERR_ARG, -1, "sph_stable_dt: nothing limits the step (no motion, no force, "
