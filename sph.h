@@ -5562,6 +5562,40 @@ static sph_status sph__reserve_blocks(sph_world* w) {
 
 /* Common start of every step: input checks, the step-independent scratch, automatic sound
    speeds, stats reset. */
+/* w.def as a step finds it: a host may change the tunable fields between steps (tolerances,
+   limits, callbacks, the solver), within their ranges; the fields the world was built from (dim,
+   spacing, kernel, h_factor, periodic directions and their box) and the ones sph_world_init
+   resolved (boundary_pressure and boundary_gamma, see there) must stay. A bad value fails the
+   step with SPH_ERR_ARG naming the field, before anything changed. */
+static sph_status sph__check_def_now(sph_world* w) {
+    const sph_world_def* d = &w->def;
+    int k, changed = d->dim != w->dim || d->spacing != w->dx || d->kernel != w->kernel.type ||
+                     d->h_factor * d->spacing != w->h;
+    for (k = 0; k < 3 && !changed; ++k)
+        changed = (d->periodic[k] != 0) != (w->priv.grid.periodic[k] != 0) ||
+                  (d->periodic[k] && (d->domain_lo[k] != w->priv.grid.lo[k] ||
+                                      d->domain_hi[k] - d->domain_lo[k] != w->priv.grid.len[k]));
+    if (changed)
+        return sph__fail(w, SPH_ERR_ARG, -1,
+                         "step: w.def.dim, spacing, kernel, h_factor, periodic or a periodic "
+                         "direction's domain_lo/hi changed after sph_world_init; make a new world");
+    if (d->boundary_pressure == SPH_BP_MIRROR)
+        return sph__fail(w, SPH_ERR_ARG, -1, "step: w.def.%s", sph__mirror_rejected);
+    if (d->boundary_pressure == SPH_BP_AUTO || !(d->boundary_gamma > 0))
+        return sph__fail(w, SPH_ERR_ARG, -1,
+                         "step: w.def.boundary_pressure = SPH_BP_AUTO or boundary_gamma = %g set "
+                         "after sph_world_init, which resolves them; set a scheme (SPH_BP_ZERO, "
+                         "SPH_BP_EXTRAPOLATE) and a gamma > 0",
+                         (double)d->boundary_gamma);
+    if (sph__validate_def(w, d) != SPH_OK) {
+        char msg[SPH_ERROR_SIZE];
+        memcpy(msg, w->error, sizeof msg);
+        return sph__fail(w, SPH_ERR_ARG, -1, "step: w.%s",
+                         msg + (strncmp(msg, "sph_world_", 10) == 0 ? 10 : 0));
+    }
+    return SPH_OK;
+}
+
 static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) {
     sph_status s;
     int k;
@@ -5572,8 +5606,8 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
                 return sph__fail(w, SPH_ERR_ARG, -1,
                                  "step: phase %d has a gas equation of state, which needs the "
                                  "internal energy only sph_step_compressible evolves", k);
-    if (w->def.boundary_pressure == SPH_BP_MIRROR) /* w.def changed after sph_world_init */
-        return sph__fail(w, SPH_ERR_ARG, -1, "step: w.def.%s", sph__mirror_rejected);
+    s = sph__check_def_now(w);
+    if (s != SPH_OK) return s;
     s = sph__check_step_input(w, dt);
     if (s != SPH_OK) return s;
     /* scratch first, so that running out of memory here changes nothing */

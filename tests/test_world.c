@@ -363,6 +363,26 @@ static void test_bad_step_input(void) {
         CHECK_EQ_INT(sph_advance(&w, (sph_real)1e-3), SPH_ERR_ARG);
         w.def.boundary_pressure = bp;
     }
+    { /* w.def changed after sph_world_init: a structural field, a tunable out of its range, a
+         field sph_world_init resolved; each refused by the step with the field named */
+        const sph_world_def keep_def = w.def;
+        w.def.spacing *= 2;
+        CHECK_EQ_INT(th_step(&w, 1e-4), SPH_ERR_ARG);
+        CHECK(strstr(w.error, "spacing") != NULL);
+        w.def = keep_def;
+        w.def.tolerance = -1;
+        CHECK_EQ_INT(sph_advance(&w, (sph_real)1e-3), SPH_ERR_ARG);
+        CHECK(strstr(w.error, "w.def.tolerance") != NULL);
+        w.def = keep_def;
+        w.def.boundary_pressure = SPH_BP_AUTO;
+        CHECK_EQ_INT(th_step(&w, 1e-4), SPH_ERR_ARG);
+        CHECK(strstr(w.error, "SPH_BP_AUTO") != NULL);
+        w.def = keep_def;
+        w.def.boundary_gamma = 0;
+        CHECK_EQ_INT(th_step(&w, 1e-4), SPH_ERR_ARG);
+        CHECK(strstr(w.error, "boundary_gamma") != NULL);
+        w.def = keep_def;
+    }
     CHECK(snap_same(&s, &w));
     CHECK_EQ_INT(sph_add_fluid(&w, ph, 1, xbad, NULL), SPH_ERR_ARG);
     CHECK_EQ_INT(sph_add_fluid(&w, ph, 1, xok, vbad), SPH_ERR_ARG);
