@@ -445,6 +445,71 @@ static double sheet_drop(int dim, sph_real contact, sph_status* status, size_t* 
     return ymin;
 }
 
+/* The crossing guard (sph__wall_cross_guard): a sheet one particle thick, 0.75 dx above a floor
+   of one layer of boundary particles (Akinci volumes), moving down so fast that one step carries
+   it 0.9 dx, past the layer's line. Without the guard the contact at the step's end found the
+   wall's normal pointing down (out of the container) and pushed the sheet on, out; with it every
+   particle goes back above the layer and keeps no velocity into it. WCSPH at a chosen dt: the
+   step is what is tested (its pressure hardly acts at this spacing from the wall). 2D and 3D. */
+static void test_wall_cross_guard(void) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        const double dx = 0.02, v = 5, dt = 0.9 * dx / v;
+        const int m = 16;
+        sph_world_def def = sph_world_def_default(dim);
+        sph_world w;
+        sph_phase water;
+        sph_real *xb, *xf, *vf;
+        size_t nb = 0, nf = 0, i;
+        int a, b;
+        double lowest = 1e9, vdown = 0;
+        memset(&water, 0, sizeof water);
+        water.rest_density = 1000;
+        water.sound_speed = 50;
+        def.spacing = (sph_real)dx;
+        def.gravity[1] = 0;
+        def.boundary_volume = SPH_BVOL_AKINCI;
+        def.density = SPH_DENSITY_SUMMATION; /* from the positions: the sheet is not compressed */
+        CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
+        CHECK(sph_world_add_phase(&w, &water) == 0);
+        xb = (sph_real*)malloc(sizeof(sph_real) * 3 * (size_t)((m + 8) * (m + 8)));
+        xf = (sph_real*)malloc(sizeof(sph_real) * 3 * (size_t)(m * m));
+        vf = (sph_real*)calloc(3 * (size_t)(m * m), sizeof(sph_real));
+        for (a = -4; a < m + 4; ++a) /* the floor: one layer at y = 0 */
+            for (b = (dim == 3 ? -4 : 0); b < (dim == 3 ? m + 4 : 1); ++b) {
+                xb[nb * (size_t)dim] = (sph_real)(a * dx);
+                xb[nb * (size_t)dim + 1] = 0;
+                if (dim == 3) xb[nb * (size_t)dim + 2] = (sph_real)(b * dx);
+                ++nb;
+            }
+        for (a = 0; a < m; ++a) /* the sheet, over the hollows of the layer */
+            for (b = 0; b < (dim == 3 ? m : 1); ++b) {
+                xf[nf * (size_t)dim] = (sph_real)((a + 0.5) * dx);
+                xf[nf * (size_t)dim + 1] = (sph_real)(0.75 * dx);
+                if (dim == 3) xf[nf * (size_t)dim + 2] = (sph_real)((b + 0.5) * dx);
+                vf[nf * (size_t)dim + 1] = (sph_real)-v;
+                ++nf;
+            }
+        CHECK_EQ_INT(sph_add_boundary(&w, nb, xb, NULL, 0), SPH_OK);
+        CHECK_EQ_INT(sph_add_fluid(&w, 0, nf, xf, vf), SPH_OK);
+        free(xb);
+        free(xf);
+        free(vf);
+        CHECK_MSG(th_step(&w, (sph_real)dt) == SPH_OK, "%s", w.error);
+        for (i = 0; i < w.n; ++i) {
+            const double y = (double)w.x[i * (size_t)dim + 1], vy = (double)w.v[i * (size_t)dim + 1];
+            if (y < lowest) lowest = y;
+            if (-vy > vdown) vdown = -vy;
+        }
+        TH_NOTE("%dD sheet at %.1f m/s onto a single layer, one step of %.2f dx: lowest centre "
+                "%+.3f dx from the layer's line, fastest downward %.3g m/s", dim, v, v * dt / dx,
+                lowest / dx, vdown);
+        CHECK_LT(0.5 * dx, lowest); /* above the layer, not through it */
+        CHECK_LT(vdown, 0.05 * v);  /* the velocity into the wall removed */
+        sph_world_free(&w);
+    }
+}
+
 static void test_wall_contact_sheet(void) {
     int dim;
     for (dim = 2; dim <= 3; ++dim) {
@@ -639,6 +704,7 @@ const th_test tests_reliability[] = {
     {"reliability/momentum_periodic", test_momentum_periodic},
     {"reliability/kinetic_energy_decays", test_kinetic_energy_decays},
     {"reliability/wall_contact_sheet", test_wall_contact_sheet},
+    {"reliability/wall_cross_guard", test_wall_cross_guard},
     {"reliability/energy_check_quiet", test_energy_check_quiet},
     {"reliability/golden_hash_threads", test_golden_hash},
     {0, 0},
