@@ -5444,9 +5444,16 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
         default:
             return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
                              "step %llu (t = %g s): fluid particle %zu (id %u) moves at %g m/s, "
-                             "above the limit %g m/s",
+                             "above the limit %g m/s (%s; if such speeds are real, raise "
+                             "def.max_speed or the phase's sound_speed)",
                              (unsigned long long)w->steps, w->time, i, (unsigned)w->id[i], sqrt(v2),
-                             (double)vlim);
+                             (double)vlim,
+                             w->def.max_speed > 0 ? "def.max_speed"
+                             : w->priv.solver == SPH_SOLVER_COMPRESSIBLE
+                                 ? "ten times the sound speed"
+                             : sph__incompressible(w->priv.solver)
+                                 ? "the sound speed plus twice the fastest wall's speed"
+                                 : "the sound speed");
         }
     }
     return SPH_OK;
