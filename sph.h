@@ -7410,12 +7410,15 @@ typedef struct sph__pbf {
     sph_real* a;       /* a_i = lambda_i / (m_i rho0_i) [m^5/kg]                                */
     sph_real* fw;      /* per fluid pair: gW_ij / x_ij, then s_ij (2 values)                    */
     sph_real* bw;      /* per wall pair: gW_ib / x_ib                                           */
-    sph_real inv_s, s2, w0, inv_wq, k, q_lat, eps_q; /* 1/S, S^2, m W(0) / m, 1 / w(dq),
+    sph_real inv_s, s2, w0, inv_wq, k, q_lat, eps_q; /* 1/S, S^2, norm_w w(0), 1 / w(dq),
                           def.pbf_scorr S^2 / Q_lat, Q_lat, eps_r Q_lat */
+    sph_real f;        /* the share of the compression a step corrects (sph__standing_keep)    */
+    sph_real* p;       /* w->p, accumulated over the projections                                */
+    sph_real p_scale;  /* 1 / (S dt^2)                                                          */
 } sph__pbf;
 
 /* The constants of a step's projections. */
-static void sph__pbf_setup(sph_world* w, sph__ctx* c, sph__pbf* P) {
+static void sph__pbf_setup(sph_world* w, sph__ctx* c, sph__pbf* P, sph_real dt) {
     const sph_real q_lat = (sph_real)sph__lattice_grad2(&w->kernel, w->dx);
     const sph_real S = w->priv.lattice_sum;
     sph__ctx_init(w, c); /* after the sort */
@@ -7432,12 +7435,19 @@ static void sph__pbf_setup(sph_world* w, sph__ctx* c, sph__pbf* P) {
     P->k = w->def.pbf_scorr * S * S / q_lat;
     P->q_lat = q_lat;
     P->eps_q = w->def.pbf_relaxation * q_lat;
+    /* a step that sph_advance shortened below the rule corrects only dt / dt_rule of the
+       compression (as PCISPH, IISPH and DFSPH do, sph__standing_keep): the correction becomes
+       the velocity dx / dt, and a retry at a hundredth of the step turned a standing 8 %
+       compression into 1000 m/s in a 20 m tank */
+    P->f = 1 - sph__standing_keep(w);
+    P->p = w->p;
+    P->p_scale = 1 / (S * dt * dt);
 }
 
 /* The first pass of a projection for particle i: rho_i, C_i and a_i at P->x (eqs. 1, 9-11), and
    the pair factors the second pass reuses (its positions are the same). Returns C_i. */
 SPH__INLINE sph_real sph__pbf_lambda_one(sph_world* w, const sph__ctx* c, const sph__pbf* P,
-                                         size_t i, const int D) {
+                                         size_t i, const int D, const int form) {
     const sph_real* xi = P->x + i * (size_t)D;
     const sph__phase_c* ph = &c->pc[c->ph[i]];
     const sph_real mi = c->m ? c->m[i] : c->m0;
@@ -7451,8 +7461,8 @@ SPH__INLINE sph_real sph__pbf_lambda_one(sph_world* w, const sph__ctx* c, const 
         sph__delta_vec(c, xi, P->x + j * (size_t)D, d, D);
         SPH__FOR_K(D, r2 += d[k] * d[k]);
         q = sph__sqrt(r2) * c->k.inv_h;
-        W = sph__kw(c->k.form, q);
-        fw = c->k.norm_g * sph__kf(c->k.form, q);
+        W = sph__kw(form, q);
+        fw = c->k.norm_g * sph__kf(form, q);
         sum += mj * W;
         SPH__FOR_K(D, G[k] += mj * fw * d[k]);
         Q += mj * fw * fw * r2;
@@ -7474,8 +7484,8 @@ SPH__INLINE sph_real sph__pbf_lambda_one(sph_world* w, const sph__ctx* c, const 
             sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
             SPH__FOR_K(D, r2 += d[k] * d[k]);
             q = sph__sqrt(r2) * c->k.inv_h;
-            sumb += c->bvol[b] * sph__kw(c->k.form, q);
-            fw = c->k.norm_g * sph__kf(c->k.form, q);
+            sumb += c->bvol[b] * sph__kw(form, q);
+            fw = c->k.norm_g * sph__kf(form, q);
             SPH__FOR_K(D, G[k] += psi * fw * d[k]);
             P->bw[kk] = fw;
         }
@@ -7485,7 +7495,7 @@ SPH__INLINE sph_real sph__pbf_lambda_one(sph_world* w, const sph__ctx* c, const 
     if (!(C > 0)) C = 0; /* eq. 1, clamped: no tension at a free surface */
     den = mi * Q + P->eps_q * mi * mi;
     SPH__FOR_K(D, den += G[k] * G[k]);
-    P->a[i] = -C * ph->rho0 * P->s2 / den; /* den >= eps_r m_i^2 Q_lat > 0 */
+    P->a[i] = -C * ph->rho0 * P->s2 * P->f / den; /* den >= eps_r m_i^2 Q_lat > 0 */
     return C;
 }
 
@@ -7516,12 +7526,15 @@ SPH__INLINE void sph__pbf_project_one(const sph__ctx* c, const sph__pbf* P, size
         }
     }
     SPH__FOR_K(D, P->xo[i * (size_t)D + (size_t)k] = xi[k] + dx[k] * P->inv_s);
+    /* the pressure of this correction, accumulated over the projections (see above) */
+    P->p[i] -= c->pc[c->ph[i]].rho0 * c->pc[c->ph[i]].rho0 * ai * P->p_scale;
 }
 
 /* The last pass, at the projected positions: rho_i, and the velocity after XSPH (eq. 17) and
    laminar viscosity, from w->v (the projection's velocities) into vo. */
 SPH__INLINE void sph__pbf_velocity_one(sph_world* w, const sph__ctx* c, const sph__pbf* P,
-                                       size_t i, const int D, sph_real dt, sph_real* vo) {
+                                       size_t i, const int D, const int form, sph_real dt,
+                                       sph_real* vo) {
     const sph_real* xi = P->x + i * (size_t)D;
     const sph_real* vi = w->v + i * (size_t)D;
     const sph__phase_c* ph = &c->pc[c->ph[i]];
@@ -7538,13 +7551,13 @@ SPH__INLINE void sph__pbf_velocity_one(sph_world* w, const sph__ctx* c, const sp
         sph__delta_vec(c, xi, P->x + j * (size_t)D, d, D);
         SPH__FOR_K(D, r2 += d[k] * d[k]);
         q = sph__sqrt(r2) * c->k.inv_h;
-        W = sph__kw(c->k.form, q);
+        W = sph__kw(form, q);
         sum += mj * W;
         f = 2 * mj / (ph->rho0 + pj->rho0) * W; /* eq. 17 */
         SPH__FOR_K(D, xs[k] += f * (vj[k] - vi[k]));
         if (c->laminar && ph->mu + pj->mu > 0) { /* Morris et al. 1997, rho0 for rho */
             f = mj * (ph->mu + pj->mu) * ph->inv_rho0 * pj->inv_rho0 * c->k.norm_g *
-                sph__kf(c->k.form, q) * r2 / (r2 + c->eta2);
+                sph__kf(form, q) * r2 / (r2 + c->eta2);
             SPH__FOR_K(D, av[k] += f * (vi[k] - vj[k]));
         }
     }
@@ -7556,7 +7569,7 @@ SPH__INLINE void sph__pbf_velocity_one(sph_world* w, const sph__ctx* c, const sp
             sph_real d[3] = {0, 0, 0}, r2 = 0;
             sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
             SPH__FOR_K(D, r2 += d[k] * d[k]);
-            sumb += c->bvol[b] * sph__kw(c->k.form, sph__sqrt(r2) * c->k.inv_h);
+            sumb += c->bvol[b] * sph__kw(form, sph__sqrt(r2) * c->k.inv_h);
         }
     }
     w->rho[i] = (mi * P->w0 + c->k.norm_w * (sum + ph->rho0 * sumb)) * P->inv_s;
@@ -7567,6 +7580,7 @@ SPH__INLINE void sph__pbf_velocity_one(sph_world* w, const sph__ctx* c, const sp
    sums, so the iteration count is the same for any number of threads. */
 static double sph__pbf_lambdas(sph_world* w, const sph__ctx* c, const sph__pbf* P) {
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
+    const int form = c->k.form, wc2 = form == SPH__KF_WC2;
     double sum = 0;
     sph__idx blk;
     size_t q;
@@ -7576,10 +7590,14 @@ static double sph__pbf_lambdas(sph_world* w, const sph__ctx* c, const sph__pbf* 
         const size_t i1 = i0 + SPH__BLOCK < w->n ? i0 + SPH__BLOCK : w->n;
         double e = 0;
         size_t i;
+        /* D and the kernel compile-time constants for Wendland C2 (the loops unroll, and w and
+           f share their powers of 1 - q/2) */
         for (i = i0; i < i1; ++i)
-            e += (double)(c->dim == 2   ? sph__pbf_lambda_one(w, c, P, i, 2)
-                          : c->dim == 3 ? sph__pbf_lambda_one(w, c, P, i, 3)
-                                        : sph__pbf_lambda_one(w, c, P, i, 1));
+            e += (double)(c->dim == 2 ? (wc2 ? sph__pbf_lambda_one(w, c, P, i, 2, SPH__KF_WC2)
+                                             : sph__pbf_lambda_one(w, c, P, i, 2, form))
+                          : c->dim == 3 ? (wc2 ? sph__pbf_lambda_one(w, c, P, i, 3, SPH__KF_WC2)
+                                               : sph__pbf_lambda_one(w, c, P, i, 3, form))
+                                        : sph__pbf_lambda_one(w, c, P, i, 1, form));
         w->priv.block[blk] = e;
     }
     for (q = 0; q < nblk; ++q) sum += w->priv.block[q];
@@ -7598,12 +7616,15 @@ static void sph__pbf_project(sph_world* w, const sph__ctx* c, const sph__pbf* P)
 
 static void sph__pbf_velocities(sph_world* w, const sph__ctx* c, const sph__pbf* P, sph_real dt,
                                 sph_real* vo) {
+    const int form = c->k.form, wc2 = form == SPH__KF_WC2;
     sph__idx i;
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) {
-        if (c->dim == 2) sph__pbf_velocity_one(w, c, P, (size_t)i, 2, dt, vo);
-        else if (c->dim == 3) sph__pbf_velocity_one(w, c, P, (size_t)i, 3, dt, vo);
-        else sph__pbf_velocity_one(w, c, P, (size_t)i, 1, dt, vo);
+        if (c->dim == 2 && wc2) sph__pbf_velocity_one(w, c, P, (size_t)i, 2, SPH__KF_WC2, dt, vo);
+        else if (c->dim == 2) sph__pbf_velocity_one(w, c, P, (size_t)i, 2, form, dt, vo);
+        else if (c->dim == 3 && wc2) sph__pbf_velocity_one(w, c, P, (size_t)i, 3, SPH__KF_WC2, dt, vo);
+        else if (c->dim == 3) sph__pbf_velocity_one(w, c, P, (size_t)i, 3, form, dt, vo);
+        else sph__pbf_velocity_one(w, c, P, (size_t)i, 1, form, dt, vo);
     }
 }
 
@@ -7641,7 +7662,7 @@ static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
     if ((s = sph__scratch(w, &w->priv.ff_fw, 2 * w->priv.ff.cap_idx)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.fb_fw, w->priv.fb.cap_idx)) != SPH_OK)
         return s;
-    sph__pbf_setup(w, &c, &P);
+    sph__pbf_setup(w, &c, &P, dt);
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) {
         const size_t o = (size_t)w->priv.grid.order[i] * (size_t)w->dim;
@@ -7663,9 +7684,6 @@ static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
         P.xo = xb;
         err = sph__pbf_lambdas(w, &c, &P);
         sph__pbf_project(w, &c, &P);
-        SPH__OMP_FOR(w->n) /* the pressure of this correction, accumulated (see above) */
-        for (i = 0; i < (sph__idx)w->n; ++i)
-            w->p[i] -= c.pc[c.ph[i]].rho0 * c.pc[c.ph[i]].rho0 * P.a[i] * P.inv_s / (dt * dt);
         tmp = xa;
         xa = xb;
         xb = tmp;
