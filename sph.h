@@ -2,8 +2,8 @@
 
    A plain-struct particle world, SPH kernels, a cell grid for neighbour search, and time steps
    for weakly compressible SPH (WCSPH), predictive-corrective incompressible SPH (PCISPH, the
-   original and an enhanced multiphase version), implicit incompressible SPH (IISPH) and
-   divergence-free SPH (DFSPH), with
+   original and an enhanced multiphase version), implicit incompressible SPH (IISPH),
+   divergence-free SPH (DFSPH) and position based fluids (PBF, for games), with
    particle walls (three boundary pressure schemes), moving and irregular boundaries, and user
    forces.
    C99, also C++; libc and libm only; OpenMP when the compiler enables it.
@@ -239,7 +239,26 @@ int main(void) {
    for large steps on liquids, DFSPH when the velocity field itself must be divergence-free
    (splashes, moving boundaries, coupling that reads velocities), at about 10 % more per step
    here; PCISPH for the multiphase engineering setups of Enhanced PCISPH 2018; the compressible step for gases,
-   shocks and large density ratios.
+   shocks and large density ratios; PBF for a fixed cost per step.
+
+   SOLVER: PBF (sph_step_pbf, or def.solver = SPH_SOLVER_PBF)
+   Position based fluids (Macklin & Mueller 2013): per step the particles are predicted with
+   gravity and def.force, then def.pbf_iterations (3) Jacobi projections of the density constraint
+   C_i = rho_i/rho0 - 1 (clamped at 0: no tension) move them, with Akinci walls as in IISPH and
+   eps relaxation (def.pbf_relaxation), the velocity is the displacement over dt, and XSPH
+   (def.pbf_xsph, 0.01) and the phases' laminar viscosity smooth it; wall contact and blow-up
+   checks as for every step. The tensile correction s_corr (def.pbf_scorr) is off: with the
+   clamp there is no tension for it to balance, and it threw a tank's surface up by 3.5 dx. No
+   pressure solve to converge: a step costs the same whatever happens, and never returns
+   SPH_ERR_NOT_CONVERGED. The price is compression: no pressure is kept between steps, so a fluid
+   at rest sinks until its compression gradient carries it, about K (1 + eps) (g H + v^2) dt^2 /
+   (iterations dx^2) on average, H the depth. sph_stable_dt therefore picks the step at which this
+   is def.pbf_compression (1 %), within the velocity limit of the other incompressible solvers;
+   it has no force limit. Measured (2D, 40-layer tank at rest, tests/test_pbf.c): 1.15 % mean
+   compression, the surface 0.9 dx lower than at rest density. Not cheaper than IISPH at equal
+   compression in a deep tank (README, "Real time in a game"); choose it for its fixed cost and
+   its robustness at large steps. w.p is the pressure whose force would have made the step's
+   correction. Details and measurements: >>pbf.
 
    BOUNDARIES
    Walls are layers of boundary particles with a volume each (sph_add_wall_box makes enough
@@ -843,7 +862,8 @@ struct sph_world;
    stage with SPH_SCHEME_SECOND_ORDER) for disjoint ranges of at most 256 particles, in parallel
    from worker threads (from the calling thread with at most 2048 fluid particles or without
    OpenMP), after the step's densities (and, except in PCISPH and IISPH, pressures) are known and
-   before the pressure and viscous forces; w->time is the time at the start of the step. It may
+   before the pressure and viscous forces (PBF: at the step's start, with the last step's
+   densities, before its prediction); w->time is the time at the start of the step. It may
    read the world and must write only acc[i*dim + k] for i in its range; it must be safe to run
    on several threads at once. The wall pressure extrapolation sees these accelerations like
    gravity. */
@@ -852,7 +872,8 @@ typedef void (*sph_force_fn)(const struct sph_world* w, size_t begin, size_t end
 
 /* Kinematic boundary motion. Called once per step, on the calling thread, before the neighbour
    search, with the time [s] at which the step evaluates forces (the start of the step; its middle
-   with Stormer-Verlet); not called while the world has no boundary particles. It sets w->b_x and
+   with Stormer-Verlet; its end with PBF, whose projection puts the particles against the walls
+   as they stand then); not called while the world has no boundary particles. It sets w->b_x and
    w->b_v for the boundary particles it moves (identify them by w->b_body, w->b_id or the
    reference position w->b_x0) and may set w->b_a (wall acceleration, used by the pressure
    extrapolation). With a callback set, walls are re-sorted every step. A non-finite b_x, b_v or
@@ -1272,19 +1293,20 @@ SPHDEF void sph_world_momentum(const sph_world* w, double* out);
 /* Largest stable time step [s] for the solver from the CFL (acoustic), viscous and force limits.
    Returns 0 and sets w->error if it cannot be determined. The first limit is cfl h / (max c0 +
    |v|max) for WCSPH, cfl h / max(c_i + |v_i|) over fluid particles for the compressible step,
-   for IISPH, PCISPH and DFSPH the velocity limit on the speed reached within the step,
+   for IISPH, PCISPH, DFSPH and PBF the velocity limit on the speed reached within the step,
    (|v|max + |a| dt) dt <= cfl_velocity dx (|v|max over fluid and boundary particles, |a| their
    largest non-pressure acceleration: a step from rest is limited too); then the viscous and
    force limits (the incompressible solvers' at 0.4 cfl_force sqrt(h / |a|) with the non-pressure
    |a|: a pressure that enforces incompressibility grows like 1 / dt, and limiting the step by it
-   feeds back) and def.max_dt (see their fields). Fills in automatic sound
+   feeds back; PBF has no force limit, but the step at which its compression is
+   def.pbf_compression, see >>pbf) and def.max_dt (see their fields). Fills in automatic sound
    speeds. Fails (SPH_ERR_ARG) for an unknown solver, when WCSPH or the compressible step lacks a
    sound speed it cannot choose, when WCSPH has no sound speed at all (e.g. no particles yet), or
    when nothing limits the step; SPH_ERR_UNSTABLE when the step rounds to 0 (e.g. |v| near the
    largest sph_real, or a cfl factor of 1e-320). */
 SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver);
-/* One step of the solver selected in def.solver: sph_step_wcsph, _iisph, _pcisph, _compressible
-   or _dfsph. */
+/* One step of the solver selected in def.solver: sph_step_wcsph, _iisph, _pcisph, _compressible,
+   _dfsph or _pbf. */
 SPHDEF sph_status sph_step(sph_world* w, sph_real dt);
 /* Advances by duration [s] in sub-steps of the stable time step (what a game calls per frame);
    the robust integrator. duration finite and >= 0. Each sub-step is dt_factor * sph_stable_dt,
@@ -7369,8 +7391,11 @@ SPHDEF sph_status sph_step_dfsph(sph_world* w, sph_real dt) {
                gW_ij = grad_i W(x_i - x_j), Q_lat = sum_j |gW|^2 over a full lattice and eps_r
                = def.pbf_relaxation: the paper's eps [1/m^2] is eps_r Q_lat (m / rho0)^2 / S^2,
                eps_r times what a lattice particle's own constraint contributes, so eps_r = 1
-               moves it half the way its own constraint asks (at eps_r = 0.25 a 2D tank's floor
-               rows ring and fail the compression check within 0.2 s). The walls do not move and
+               moves it half the way its own constraint asks: Jacobi sums the corrections of all
+               neighbours' constraints and overshoots without it (measured in the 20 m tank of
+               examples/realtime.c at the same compression target: eps_r = 0.25 failed the
+               compression check at t = 0.21 s, 0.5 ran with 2.2 % mean compression against
+               1.4 % at 1, in about the same time). The walls do not move and
                carry no multiplier: the constraint's own wall term (zero wall pressure; >>iisph
                derives why). Every pair term is antisymmetric (m_i dx_i + m_j dx_j = 0 per pair),
                so without walls momentum is conserved to round-off;
@@ -7400,10 +7425,12 @@ SPHDEF sph_status sph_step_dfsph(sph_world* w, sph_real dt) {
    m_j (p_i/rho_i^2 + p_j/rho_j^2) gW_ij, i.e. p_i = -rho0_i^2 sum_projections a_i / (S dt^2):
    PBF has no pressure of its own, and a host that colours by pressure sees the load.
    Compression: a projection reaches one kernel radius and keeps nothing between steps but the
-   compression left in the positions, so a fluid at rest settles where its per-step correction
-   balances gravity's g dt^2: the compression grows along the depth like g dt^2 / (iterations
-   Q_lat dx^2 (m / rho0)^2 ...), i.e. with dt^2 and the depth in particles, and falls as
-   1 / iterations (measured below, sph__pbf_dt). */
+   compression left in the positions (no warm start, unlike IISPH's pressure), so a fluid at rest
+   sinks until the correction of its compression gradient, iterations times per step, balances
+   gravity's g dt^2: its compression grows with dt^2 and with the depth in particles, and falls
+   as 1 / iterations (sph__pbf_dt gives the rule and its constant). A compressed block relaxes
+   from its rim inwards, one kernel radius per projection (tests/test_pbf.c: 16 x 16 particles
+   10.8 % compressed keep 5.8 % after 1 projection, 1.9 % after 8, 0.08 % after 32). */
 typedef struct sph__pbf {
     const sph_real* x; /* positions the pass reads (x*, then the last projection's)            */
     sph_real* xo;      /* positions a projection writes                                         */
@@ -7721,7 +7748,16 @@ static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
    mean compression is about
        c = K (1 + eps_r) (|g| H + |v|max^2) dt^2 / (iterations dx^2),
    H the fluid's extent along gravity plus dx (|g| H the hydrostatic, |v|^2 the dynamic pressure
-   over rho0), K measured below. The limit is the dt of c = def.pbf_compression. */
+   over rho0). The limit is the dt of c = def.pbf_compression. K = 0.12 from 2D tanks at rest,
+   started from rest density, through sph_advance in frames of 1/60 s (3 projections, eps_r = 1;
+   mean over the frames): a 1 m tank 20 layers deep settled to 0.55, 0.97 and 1.79 % at targets
+   of 0.5, 1 and 2 % (2 s), the 20 m tank of examples/realtime.c (50 layers, 10k particles) to
+   0.95 and 1.76 % at 1 and 2 % (3 s), the 40-layer tank of tests/test_pbf.c to 1.15 % at 1 %
+   (frames of 0.05 s). A start from rest density overshoots
+   about twice the mean it settles to (the fluid falls until its compression carries it): the
+   20 m tank at a 4 % target reached 7.7 % at 0.3 s and failed the 20 % bound of
+   max_compression. Without gravity and motion nothing limits the step (sph_stable_dt then fails
+   unless viscosity or def.max_dt does). */
 #define SPH__PBF_K 0.12
 static double sph__pbf_dt(const sph_world* w, double v2max) {
     const int D = w->dim;
