@@ -7659,6 +7659,7 @@ static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
     const size_t nD = w->n * (size_t)w->dim;
     double t0 = sph__now(), tstart = t0, err = 0;
     sph_real *xa, *xb, *tmp;
+    uint64_t sorts;
     sph__ctx c;
     sph__pbf P;
     sph_status s;
@@ -7673,10 +7674,13 @@ static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
     s = sph__boundary_motion(w, w->time + (double)dt);
     if (s != SPH_OK) return s;
     sph__time(w, SPH_STAGE_BOUNDARY, &t0);
-    /* predict: v* = v + dt a_ext, x* = x + dt v* (Algorithm 1, lines 2-3) */
+    /* predict: v* = v + dt a_ext, x* = x + dt v* (Algorithm 1, lines 2-3); x^n and v^n kept in
+       xp and vp until the search has succeeded */
     sph__ctx_init(w, &c);
     if ((s = sph__stage_body_force(w, &c)) != SPH_OK) return s;
     sph__record_nonpressure(w);
+    sph__copy(w->priv.xp, w->x, nD * sizeof(sph_real));
+    sph__copy(w->priv.vp, w->v, nD * sizeof(sph_real));
     SPH__OMP_FOR(nD)
     for (i = 0; i < (sph__idx)nD; ++i) {
         w->v[i] += dt * w->a[i];
@@ -7684,11 +7688,20 @@ static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
     }
     sph__time(w, SPH_STAGE_FORCES, &t0);
     /* neighbours at x* (line 5); a_ext follows the sort into ap */
+    sorts = w->priv.sorts;
     s = sph__stage_neighbors(w);
-    if (s != SPH_OK) return s;
-    if ((s = sph__scratch(w, &w->priv.ff_fw, 2 * w->priv.ff.cap_idx)) != SPH_OK ||
-        (s = sph__scratch(w, &w->priv.fb_fw, w->priv.fb.cap_idx)) != SPH_OK)
+    if (s == SPH_OK) s = sph__scratch(w, &w->priv.ff_fw, 2 * w->priv.ff.cap_idx);
+    if (s == SPH_OK) s = sph__scratch(w, &w->priv.fb_fw, w->priv.fb.cap_idx);
+    if (s != SPH_OK) { /* out of memory: x^n and v^n back, so a repeated call predicts once */
+        sph__undo_drift(w, w->priv.xp, sorts);
+        if (w->priv.sorts == sorts) sph__copy(w->v, w->priv.vp, nD * sizeof(sph_real));
+        else
+            for (i = 0; i < (sph__idx)w->n; ++i)
+                memcpy(w->v + (size_t)i * (size_t)w->dim,
+                       w->priv.vp + (size_t)w->priv.grid.order[i] * (size_t)w->dim,
+                       (size_t)w->dim * sizeof(sph_real));
         return s;
+    }
     sph__pbf_setup(w, &c, &P, dt);
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) {
