@@ -7655,15 +7655,79 @@ static void sph__pbf_velocities(sph_world* w, const sph__ctx* c, const sph__pbf*
     }
 }
 
-static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
+/* Prediction (Algorithm 1, lines 2-3): v* = v + dt a_ext, x* = x + dt v*, with x^n and v^n kept
+   in xp and vp until the neighbour search has succeeded. */
+static void sph__pbf_predict(sph_world* w, sph_real dt) {
     const size_t nD = w->n * (size_t)w->dim;
+    sph__idx i;
+    sph__copy(w->priv.xp, w->x, nD * sizeof(sph_real));
+    sph__copy(w->priv.vp, w->v, nD * sizeof(sph_real));
+    SPH__OMP_FOR(nD)
+    for (i = 0; i < (sph__idx)nD; ++i) {
+        w->v[i] += dt * w->a[i];
+        w->x[i] += dt * w->v[i];
+    }
+}
+
+/* Out of memory in the search: x^n and v^n back (read through the sort's permutation if the
+   particles were sorted), so that a repeated call predicts once. */
+static void sph__pbf_unpredict(sph_world* w, uint64_t sorts) {
+    const size_t D = (size_t)w->dim;
+    size_t i;
+    sph__undo_drift(w, w->priv.xp, sorts);
+    if (w->priv.sorts == sorts) sph__copy(w->v, w->priv.vp, w->n * D * sizeof(sph_real));
+    else
+        for (i = 0; i < w->n; ++i)
+            memcpy(w->v + i * D, w->priv.vp + (size_t)w->priv.grid.order[i] * D, D * sizeof(sph_real));
+}
+
+/* After the sort: a_ext into ap (w->a is scratch, not sorted), x* into xp for the projections,
+   x back to x^n (to rounding) for the final move, and w->p cleared for its accumulation. */
+static void sph__pbf_begin(sph_world* w, sph_real dt) {
+    const size_t D = (size_t)w->dim;
+    sph__idx i;
+    SPH__OMP_FOR(w->n)
+    for (i = 0; i < (sph__idx)w->n; ++i) {
+        const size_t o = (size_t)w->priv.grid.order[i] * D;
+        size_t k;
+        for (k = 0; k < D; ++k) {
+            const size_t q = (size_t)i * D + k;
+            w->priv.ap[q] = w->a[o + k];
+            w->priv.xp[q] = w->x[q];
+            w->x[q] -= dt * w->v[q];
+        }
+        w->p[i] = 0;
+    }
+}
+
+/* Line 21: v = (x_proj - x^n) / dt; then line 22 (XSPH, viscosity) through scratch `vo`, and
+   w->a = (v^{n+1} - v^n) / dt for the diagnostics. */
+static void sph__pbf_velocity(sph_world* w, const sph__ctx* c, sph__pbf* P, const sph_real* xproj,
+                              sph_real* vo, sph_real dt) {
+    const size_t nD = w->n * (size_t)w->dim;
+    sph__idx i;
+    SPH__OMP_FOR(nD)
+    for (i = 0; i < (sph__idx)nD; ++i) {
+        const sph_real v = (xproj[i] - w->x[i]) / dt;
+        w->a[i] = w->priv.ap[i] - w->v[i] / dt; /* a_ext - v* / dt, completed below */
+        w->v[i] = v;
+    }
+    P->x = xproj;
+    sph__pbf_velocities(w, c, P, dt, vo);
+    SPH__OMP_FOR(nD)
+    for (i = 0; i < (sph__idx)nD; ++i) {
+        w->v[i] = vo[i];
+        w->a[i] += vo[i] / dt;
+    }
+}
+
+static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
     double t0 = sph__now(), tstart = t0, err = 0;
     sph_real *xa, *xb, *tmp;
     uint64_t sorts;
     sph__ctx c;
     sph__pbf P;
     sph_status s;
-    sph__idx i;
     int it;
     if ((s = sph__scratch(w, &w->priv.xp, w->capacity * (size_t)w->dim)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.vp, w->capacity * (size_t)w->dim)) != SPH_OK ||
@@ -7674,49 +7738,25 @@ static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
     s = sph__boundary_motion(w, w->time + (double)dt);
     if (s != SPH_OK) return s;
     sph__time(w, SPH_STAGE_BOUNDARY, &t0);
-    /* predict: v* = v + dt a_ext, x* = x + dt v* (Algorithm 1, lines 2-3); x^n and v^n kept in
-       xp and vp until the search has succeeded */
+    /* predict with gravity and def.force at x^n */
     sph__ctx_init(w, &c);
     if ((s = sph__stage_body_force(w, &c)) != SPH_OK) return s;
     sph__record_nonpressure(w);
-    sph__copy(w->priv.xp, w->x, nD * sizeof(sph_real));
-    sph__copy(w->priv.vp, w->v, nD * sizeof(sph_real));
-    SPH__OMP_FOR(nD)
-    for (i = 0; i < (sph__idx)nD; ++i) {
-        w->v[i] += dt * w->a[i];
-        w->x[i] += dt * w->v[i];
-    }
+    sph__pbf_predict(w, dt);
     sph__time(w, SPH_STAGE_FORCES, &t0);
-    /* neighbours at x* (line 5); a_ext follows the sort into ap */
+    /* neighbours at x* (line 5), kept for the whole step */
     sorts = w->priv.sorts;
     s = sph__stage_neighbors(w);
     if (s == SPH_OK) s = sph__scratch(w, &w->priv.ff_fw, 2 * w->priv.ff.cap_idx);
     if (s == SPH_OK) s = sph__scratch(w, &w->priv.fb_fw, w->priv.fb.cap_idx);
-    if (s != SPH_OK) { /* out of memory: x^n and v^n back, so a repeated call predicts once */
-        sph__undo_drift(w, w->priv.xp, sorts);
-        if (w->priv.sorts == sorts) sph__copy(w->v, w->priv.vp, nD * sizeof(sph_real));
-        else
-            for (i = 0; i < (sph__idx)w->n; ++i)
-                memcpy(w->v + (size_t)i * (size_t)w->dim,
-                       w->priv.vp + (size_t)w->priv.grid.order[i] * (size_t)w->dim,
-                       (size_t)w->dim * sizeof(sph_real));
+    if (s != SPH_OK) {
+        sph__pbf_unpredict(w, sorts);
         return s;
     }
     sph__pbf_setup(w, &c, &P, dt);
-    SPH__OMP_FOR(w->n)
-    for (i = 0; i < (sph__idx)w->n; ++i) {
-        const size_t o = (size_t)w->priv.grid.order[i] * (size_t)w->dim;
-        int k;
-        for (k = 0; k < w->dim; ++k) {
-            const size_t q = (size_t)i * (size_t)w->dim + (size_t)k;
-            w->priv.ap[q] = w->a[o + (size_t)k];
-            w->priv.xp[q] = w->x[q];       /* x*, which the projections move */
-            w->x[q] -= dt * w->v[q];       /* x^n again (to rounding), for the final move */
-        }
-        w->p[i] = 0;
-    }
+    sph__pbf_begin(w, dt);
     sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
-    /* project (lines 8-19): Jacobi, two passes each */
+    /* project (lines 8-19): Jacobi, two passes each, between the buffers xp and vp */
     xa = w->priv.xp;
     xb = w->priv.vp;
     for (it = 0; it < w->def.pbf_iterations; ++it) {
@@ -7729,20 +7769,8 @@ static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
         xb = tmp;
     }
     sph__time(w, SPH_STAGE_PRESSURE, &t0);
-    /* velocity (line 21), XSPH and viscosity (line 22) at the projected positions xa */
-    SPH__OMP_FOR(nD)
-    for (i = 0; i < (sph__idx)nD; ++i) {
-        const sph_real v = (xa[i] - w->x[i]) / dt;
-        w->a[i] = w->priv.ap[i] - w->v[i] / dt; /* completed below: (v^{n+1} - v^n) / dt */
-        w->v[i] = v;
-    }
-    P.x = xa;
-    sph__pbf_velocities(w, &c, &P, dt, xb);
-    SPH__OMP_FOR(nD)
-    for (i = 0; i < (sph__idx)nD; ++i) {
-        w->v[i] = xb[i];
-        w->a[i] += xb[i] / dt;
-    }
+    /* velocity, XSPH and viscosity at the projected positions xa (lines 21-22) */
+    sph__pbf_velocity(w, &c, &P, xa, xb, dt);
     sph__time(w, SPH_STAGE_FORCES, &t0);
     /* move x^{n+1} = x^n + dt v (line 23), wall contact, diagnostics and blow-up checks */
     w->stats.iterations = it;
