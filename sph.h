@@ -254,7 +254,8 @@ int main(void) {
    at rest sinks until its compression gradient carries it, about K (1 + eps) (g H + v^2) dt^2 /
    (iterations dx^2) on average, H the depth. sph_stable_dt therefore picks the step at which this
    is def.pbf_compression (1 %), within the velocity limit of the other incompressible solvers;
-   it has no force limit. Measured (2D, 40-layer tank at rest, tests/test_pbf.c): 1.15 % mean
+   it has no force limit and no cap of its own (def.max_dt is one; sph_advance never steps past
+   the end of a frame). Measured (2D, 40-layer tank at rest, tests/test_pbf.c): 1.15 % mean
    compression, the surface 0.9 dx lower than at rest density. Not cheaper than IISPH at equal
    compression in a deep tank (README, "Real time in a game"); choose it for its fixed cost and
    its robustness at large steps. w.p is the pressure whose force would have made the step's
