@@ -7397,8 +7397,9 @@ SPHDEF sph_status sph_step_dfsph(sph_world* w, sph_real dt) {
                moves it half the way its own constraint asks: Jacobi sums the corrections of all
                neighbours' constraints and overshoots without it (measured in the 20 m tank of
                examples/realtime.c at the same compression target: eps_r = 0.25 failed the
-               compression check at t = 0.21 s, 0.5 ran with 2.2 % mean compression against
-               1.4 % at 1, in about the same time). The walls do not move and
+               compression check at t = 0.21 s; 0.5 ran at 2-2.7 % mean compression against
+               1.4-1.8 % at 1, at the 1.15 times longer step the rule then gives). The walls do
+               not move and
                carry no multiplier: the constraint's own wall term (zero wall pressure; >>iisph
                derives why). Every pair term is antisymmetric (m_i dx_i + m_j dx_j = 0 per pair),
                so without walls momentum is conserved to round-off;
@@ -7421,7 +7422,7 @@ SPHDEF sph_status sph_step_dfsph(sph_world* w, sph_real dt) {
    0.9 J without; at 1.3 ms steps they reached 0.92 m: s_corr is a fixed displacement per
    projection, a force that grows like 1 / dt^2):
                  s_ij = -k (W_ij / W(dq))^n S^2 (rho0_i + rho0_j) / (2 m_i m_j Q_lat)      eq. 13
-   with k = def.pbf_scorr (0.1), n = 4, |dq| = 0.2 support radii (the paper: k = 0.1, n = 4,
+   with k = def.pbf_scorr (default 0), n = 4, |dq| = 0.2 support radii (the paper: k = 0.1, n = 4,
    |dq| = 0.1 ... 0.3 h, its h being the support radius). The last factor is the multiplier a
    lattice particle gets per unit C: the paper adds a bare number to lambda, which carries m^2
    with its unit masses, so its k is not scale-free. Vorticity confinement (eqs. 15-16) is not
