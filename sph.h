@@ -251,12 +251,12 @@ int main(void) {
    clamp there is no tension for it to balance, and it lifted a tank's top particles by 1.6 dx. No
    pressure solve to converge: a step costs the same whatever happens, and never returns
    SPH_ERR_NOT_CONVERGED. The price is compression: no pressure is kept between steps, so a fluid
-   at rest sinks until its compression gradient carries it, about K (1 + eps) (g H + v^2) dt^2 /
-   (iterations dx^2) on average, H the depth. sph_stable_dt therefore picks the step at which this
+   at rest sinks until its compression gradient carries it, about K (1 + eps) max(g H, v^2) dt^2
+   / (iterations dx^2) on average, H the depth. sph_stable_dt therefore picks the step at which this
    is def.pbf_compression (1 %), within the velocity limit of the other incompressible solvers;
    it has no force limit and no cap of its own (def.max_dt is one; sph_advance never steps past
-   the end of a frame). Measured (2D, 40-layer tank at rest, tests/test_pbf.c): 1.15 % mean
-   compression, the surface 0.9 dx lower than at rest density. Not cheaper than IISPH at equal
+   the end of a frame). Measured (2D, 40-layer tank at rest, tests/test_pbf.c): 1.17 % mean
+   compression, the surface 0.8 dx lower than at rest density. Not cheaper than IISPH at equal
    compression in a deep tank (README, "Real time in a game"); choose it for its fixed cost and
    its robustness at large steps. w.p is the pressure whose force would have made the step's
    correction. Details and measurements: >>pbf.
@@ -7795,13 +7795,16 @@ static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
    compression gradient by a displacement of about its multiplier's gradient, so a fluid at rest
    settles where iterations times that balances the pressure scale's displacement per step; its
    mean compression is about
-       c = K (1 + eps_r) (|g| H + |v|max^2) dt^2 / (iterations dx^2),
+       c = K (1 + eps_r) max(|g| H, |v|max^2) dt^2 / (iterations dx^2),
    H the fluid's extent along gravity plus dx (|g| H the hydrostatic, |v|^2 the dynamic pressure
-   over rho0). The limit is the dt of c = def.pbf_compression. K = 0.12 from 2D tanks at rest,
+   over rho0; their sum instead of the larger took 1.2 times the steps in the bench's dam breaks,
+   `./build/bench tts --scene 2d|3d-6k --solver pbf`: 1408 against 1196 sub-steps to t = 1 s in
+   2D, 400 against 328 in 3D, at a mean compression of 0.15 against 0.22 % and 0.07 against
+   0.11 %). The limit is the dt of c = def.pbf_compression. K = 0.12 from 2D tanks at rest,
    started from rest density, through sph_advance in frames of 1/60 s (3 projections, eps_r = 1;
    mean over the frames): a 1 m tank 20 layers deep settled to 0.55, 0.97 and 1.79 % at targets
    of 0.5, 1 and 2 % (2 s), the 20 m tank of examples/realtime.c (50 layers, 10k particles) to
-   0.95 and 1.76 % at 1 and 2 % (3 s), the 40-layer tank of tests/test_pbf.c to 1.15 % at 1 %
+   0.95 and 1.76 % at 1 and 2 % (3 s), the 40-layer tank of tests/test_pbf.c to 1.17 % at 1 %
    (frames of 0.05 s). A start from rest density overshoots
    about twice the mean it settles to (the fluid falls until its compression carries it): the
    20 m tank at a 4 % target reached 7.7 % at 0.3 s and failed the 20 % bound of
@@ -7822,7 +7825,7 @@ static double sph__pbf_dt(const sph_world* w, double v2max) {
             lo = y < lo ? y : lo;
             hi = y > hi ? y : hi;
         }
-    scale = v2max + (w->n > 0 && g2 > 0 ? hi - lo + sqrt(g2) * (double)w->dx : 0);
+    scale = fmax(v2max, w->n > 0 && g2 > 0 ? hi - lo + sqrt(g2) * (double)w->dx : 0);
     if (!(scale > 0)) return 1e300;
     return (double)w->dx * sqrt((double)w->def.pbf_compression * w->def.pbf_iterations /
                                 (SPH__PBF_K * (1 + (double)w->def.pbf_relaxation) * scale));
