@@ -35,7 +35,7 @@ export OMP_WAIT_POLICY
 
 TEST_SRC = tests/main.c tests/impl.c tests/test_kernels.c tests/test_grid.c tests/test_operators.c \
            tests/test_world.c tests/test_wcsph.c tests/test_pcisph.c tests/test_iisph.c \
-           tests/test_dfsph.c \
+           tests/test_dfsph.c tests/test_pbf.c \
            tests/test_compressible.c tests/test_soc.c tests/test_io.c tests/test_save.c \
            tests/test_reliability.c tests/test_oom.c tests/test_validation.c tests/test_scenes.c \
            tests/test_hostile.c tests/test_viscous.c tests/test_layers.c tests/test_rt.c \

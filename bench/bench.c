@@ -693,7 +693,7 @@ static int suite_tts(const opts* o) {
         svg_chart ch;
         char label[64];
         svg_begin(&ch, "Time to solution, dam break, sph_advance with defaults",
-                  "1 WCSPH, 2 PCISPH enh., 3 PCISPH orig., 4 IISPH, 5 DFSPH",
+                  "1 WCSPH, 2 PCISPH enh., 3 PCISPH orig., 4 IISPH, 5 DFSPH, 6 PBF",
                   "wall s per simulated s (runs that finished)");
         svg_log(&ch, 1);
         svg_range(&ch, 0, 0.5, TTS_NSOLVER + 0.5);
@@ -838,7 +838,7 @@ int main(int argc, char** argv) {
     if (solver_arg && !(o.tts_solvers = name_mask(solver_arg, tts_solver_names, TTS_NSOLVER))) {
         fprintf(stderr,
                 "bench: unknown solver %s (run: wcsph, pcisph, pcisph-enh, iisph; tts: a list "
-                "of those and dfsph, or all)\n",
+                "of those, dfsph and pbf, or all)\n",
                 solver_arg);
         return 2;
     }

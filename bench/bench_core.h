@@ -414,6 +414,9 @@ BENCH_FN int BX(tts_build)(sph_world* w, int scene, int solver, int quick) {
     case TTS_DFSPH:
         def.solver = SPH_SOLVER_DFSPH;
         break;
+    case TTS_PBF:
+        def.solver = SPH_SOLVER_PBF;
+        break;
     default:
         break;
     }

@@ -52,7 +52,7 @@ typedef struct bench_result {
 
 /* Time to solution (the tts suite): scenes and solvers as a user sets them up, library defaults. */
 enum { TTS_DAM2D, TTS_DAM3D_COARSE, TTS_DAM3D_FINE, TTS_NSCENE };
-enum { TTS_WCSPH, TTS_PCISPH_ENH, TTS_PCISPH, TTS_IISPH, TTS_DFSPH, TTS_NSOLVER };
+enum { TTS_WCSPH, TTS_PCISPH_ENH, TTS_PCISPH, TTS_IISPH, TTS_DFSPH, TTS_PBF, TTS_NSOLVER };
 
 static const char* const tts_scene_names[TTS_NSCENE] = {"2d", "3d-6k", "3d-59k"};
 static const char* const tts_scene_what[TTS_NSCENE] = {
@@ -60,7 +60,7 @@ static const char* const tts_scene_what[TTS_NSCENE] = {
     "DamBreakModel: 19^3 cube, dx 0.05 m, in a 4 x 3 x 1.5 m box, nu 0.01",
     "DamBreakModel: 39^3 cube, dx 0.025 m, in a 4 x 3 x 1.5 m box, nu 0.01"};
 static const char* const tts_solver_names[TTS_NSOLVER] = {"wcsph", "pcisph-enh", "pcisph",
-                                                          "iisph", "dfsph"};
+                                                          "iisph", "dfsph", "pbf"};
 
 #define TTS_FRAME 0.02 /* one frame, 1/50 s: the duration of each sph_advance call */
 

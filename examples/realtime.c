@@ -1,6 +1,6 @@
 /* realtime.c - an interactive 2D SPH tank for game programmers (SDL2).
    10k water particles in a closed tank: stir them with the mouse, run a wave paddle, switch
-   between the three pressure solvers while it runs. By default the tank is at game scale,
+   between the four pressure solvers while it runs. By default the tank is at game scale,
    20 m x 12.5 m with 5 m of water and 0.1 m particles (--scale 1: the 1.6 m x 1.0 m model tank
    it is scaled from, see "scene"), stepped by IISPH at a 0.5 % mean compression tolerance with
    sph.h's own step control. Each frame simulates the wall time of the last frame within a budget
@@ -11,20 +11,23 @@
 
    Build: cc -O2 -std=c99 -fopenmp -I. examples/realtime.c $(sdl2-config --cflags --libs) -lm \
              -o build/realtime                       (or: make realtime; Debian: libsdl2-dev)
-   Run:   ./build/realtime [--particles 10000] [--solver wcsph|pcisph|iisph] [--scale 12.5]
-                           [--tolerance 0.005 (IISPH's)] [--adapt 1] [--budget 40 (ms per frame)]
+   Run:   ./build/realtime [--particles 10000] [--solver wcsph|pcisph|iisph|pbf] [--scale 12.5]
+                           [--tolerance 0.005 (IISPH's)] [--compression 0.02 (PBF's)] [--adapt 1]
+                           [--budget 40 (ms per frame)]
    Check: xvfb-run -a ./build/realtime --frames 150 --screenshot out/realtime.png [--solver iisph]
           runs scripted input (a stirring drag, a pull, the paddle) without a user, then writes
           the last frame as a PNG, one summary line per solver and the final line
           "real-time factor X at N particles, solver S" (simulated time over wall time of all
           frames, drawing included; N at the end); exit status 1 if a step failed or a particle
-          left the tank. Without --solver the run switches WCSPH -> PCISPH -> IISPH at each
-          third. SDL_VIDEODRIVER=offscreen or dummy also work.
+          left the tank. Without --solver the run switches WCSPH -> PCISPH -> IISPH -> PBF at
+          each quarter. SDL_VIDEODRIVER=offscreen or dummy also work.
 
    Keys:  left mouse   stir: drags the water near the cursor along with the cursor's motion
           right mouse  pull: draws the water near the cursor towards it
-          1 / 2 / 3    WCSPH / PCISPH (enhanced) / IISPH (rebuilds the world from the current
-                       particle positions and velocities); IISPH runs first, the quickest here
+          1 / 2 / 3 / 4  WCSPH / PCISPH (enhanced) / IISPH / PBF (rebuilds the world from the
+                       current particle positions and velocities); IISPH runs first: PBF, the
+                       position based solver meant for games, is 1.25 times quicker here but
+                       three times as compressed (README, "Real time in a game")
           P paddle on/off   R reset   Esc quit
    Threads: OpenMP uses every core. On a machine busy with other work, OMP_WAIT_POLICY=passive
    keeps waiting threads from spinning (with gcc's default a step can take 10x longer there). */
@@ -61,6 +64,10 @@
    (0.67-0.69 against 0.65). PCISPH keeps 0.1 %: at 1 % it let a particle out of the tank. */
 #define TOL_IISPH 0.005
 #define TOL_PCISPH 0.001
+/* PBF: the mean compression its steps are chosen for (def.pbf_compression; sph_stable_dt picks
+   the step from it, see sph.h's >>pbf) and its projections per step (def.pbf_iterations) */
+#define PBF_COMPRESSION 0.02
+#define PBF_ITERATIONS 3
 #define PADDLE_BODY 1    /* body tag of the paddle's boundary particles */
 #define PADDLE_X 1.25    /* paddle centre [m] (snapped to the particle lattice) */
 #define PADDLE_AMP 0.1   /* stroke amplitude [m] */
@@ -89,9 +96,11 @@ static double tim(double model) { return model * sqrt(scene_scale); }   /* times
 #define NBIN 32         /* speed colours */
 #define VCOLOR 1.0      /* speed [m/s] at the top of the colour map */
 
-static const char* const solver_name[3] = {"WCSPH", "PCISPH (enhanced)", "IISPH"};
-static const char* const solver_arg[3] = {"wcsph", "pcisph", "iisph"};
-static const sph_solver solver_id[3] = {SPH_SOLVER_WCSPH, SPH_SOLVER_PCISPH, SPH_SOLVER_IISPH};
+#define NSOLVER 4
+static const char* const solver_name[NSOLVER] = {"WCSPH", "PCISPH (enhanced)", "IISPH", "PBF"};
+static const char* const solver_arg[NSOLVER] = {"wcsph", "pcisph", "iisph", "pbf"};
+static const sph_solver solver_id[NSOLVER] = {SPH_SOLVER_WCSPH, SPH_SOLVER_PCISPH, SPH_SOLVER_IISPH,
+                                              SPH_SOLVER_PBF};
 
 /* Mouse state in world units. Written by the main thread between steps, read by the force
    callback on the worker threads during a step. */
@@ -113,6 +122,7 @@ typedef struct demo {
     int particles, solver;      /* requested particle count; 0, 1, 2 = WCSPH, PCISPH, IISPH */
     double budget;              /* simulation wall time per frame [s] */
     double tol_iisph;           /* IISPH's def.tolerance [-] */
+    double pbf_compression;     /* PBF's def.pbf_compression [-] */
     int adapt;                  /* nonzero: fewer particles when the water falls behind real time */
     double win_sim, win_real;   /* adapt: simulated and wall time [s] since the last reset */
     int reduced;                /* times the detail was reduced */
@@ -252,6 +262,8 @@ static sph_status build_world(demo* d, const sph_real* x, const sph_real* v, siz
     else def.solver = solver_id[d->solver];
     if (def.solver == SPH_SOLVER_PCISPH) def.tolerance = (sph_real)TOL_PCISPH;
     if (def.solver == SPH_SOLVER_IISPH) def.tolerance = (sph_real)d->tol_iisph;
+    def.pbf_compression = (sph_real)d->pbf_compression;
+    def.pbf_iterations = PBF_ITERATIONS;
 
     /* the particles that left the tank, w.stats.n_outside: those beyond the centres of the first
        wall layer (the water's outer particles sit half a spacing inside the walls' inner face) */
@@ -534,7 +546,7 @@ static void draw_hud(SDL_Renderer* r, SDL_Texture* tex, img* hud, const demo* d,
              "compression %.2f %%", m->sim_ms, m->frame_ms, m->steps, 1e3 * d->w.stats.dt,
              100 * d->w.stats.compression_avg);
     img_text(hud, 8, 26, 2, line, 20, 20, 30);
-    snprintf(line, sizeof(line), "keys: 1 WCSPH  2 PCISPH  3 IISPH   P paddle (%s)   R reset   "
+    snprintf(line, sizeof(line), "keys: 1 WCSPH  2 PCISPH  3 IISPH  4 PBF   P paddle (%s)   R reset   "
              "Esc quit      mouse: left stir, right pull", d->pad.on ? "on" : "off");
     img_text(hud, 8, 50, 1, line, 60, 60, 70);
     if (d->msg[0] && now() < d->msg_until) img_text(hud, 8, 62, 1, d->msg, 200, 30, 30);
@@ -556,6 +568,7 @@ typedef struct tally {
     double wall, cpu; /* wall time of its frames, drawing included, and the process's CPU time in
                          them (all threads) [s]: cpu / wall near the thread count = a free machine */
     double comp_max;  /* largest mean compression after a frame [-] */
+    double comp_sum;  /* mean compressions after the frames, summed [-] */
     size_t outside;   /* most particles outside the tank after any frame */
     size_t n;         /* particles at its last frame */
     int errors;       /* failed steps (each followed by a reset) */
@@ -573,7 +586,7 @@ static double median(double* v, int n) {
 
 static int parse_solver(const char* s) {
     int k;
-    for (k = 0; k < 3; ++k)
+    for (k = 0; k < NSOLVER; ++k)
         if (strcmp(s, solver_arg[k]) == 0) return k;
     return -1;
 }
@@ -601,7 +614,7 @@ static SDL_Renderer* open_window(int w, int h, int check, SDL_Window** win) {
 int main(int argc, char** argv) {
     demo d;
     meter hudm; /* the numbers on screen */
-    tally tal[3];
+    tally tal[NSOLVER];
     img hud;
     int frames = 0, fixed = -1, running = 1, frame = 0, steps = 0, status = 0, a, k;
     const char* shot = NULL;
@@ -616,6 +629,7 @@ int main(int argc, char** argv) {
     d.particles = 10000;
     d.budget = 0.040;
     d.tol_iisph = TOL_IISPH;
+    d.pbf_compression = PBF_COMPRESSION;
     d.adapt = 1;
     d.pad.on = 1;
     for (a = 1; a < argc; a += 2) { /* options come in pairs: --name value */
@@ -626,24 +640,27 @@ int main(int argc, char** argv) {
         else if (strcmp(argv[a], "--budget") == 0 && v) d.budget = atof(v) / 1000;
         else if (strcmp(argv[a], "--scale") == 0 && v) scene_scale = atof(v);
         else if (strcmp(argv[a], "--tolerance") == 0 && v) d.tol_iisph = atof(v);
+        else if (strcmp(argv[a], "--compression") == 0 && v) d.pbf_compression = atof(v);
         else if (strcmp(argv[a], "--adapt") == 0 && v) d.adapt = atoi(v);
         else if (strcmp(argv[a], "--solver") == 0 && v && parse_solver(v) >= 0)
             fixed = parse_solver(v);
         else break;
     }
     if (a < argc || d.particles < 100 || d.particles > 1000000 || frames < 0 || !(d.budget > 0) ||
-        !(scene_scale >= 0.01 && scene_scale <= 1000) || !(d.tol_iisph > 0 && d.tol_iisph < 1)) {
-        fprintf(stderr, "usage: %s [--particles 100..1000000] [--solver wcsph|pcisph|iisph] "
-                        "[--scale 0.01..1000 (%g)] [--tolerance IISPH's, 0..1 (%g)] [--adapt 0|1] "
+        !(scene_scale >= 0.01 && scene_scale <= 1000) || !(d.tol_iisph > 0 && d.tol_iisph < 1) ||
+        !(d.pbf_compression > 0 && d.pbf_compression <= 0.1)) {
+        fprintf(stderr, "usage: %s [--particles 100..1000000] [--solver wcsph|pcisph|iisph|pbf] "
+                        "[--scale 0.01..1000 (%g)] [--tolerance IISPH's, 0..1 (%g)] "
+                        "[--compression PBF's, 0..0.1 (%g)] [--adapt 0|1] "
                         "[--budget ms > 0] [--frames N [--screenshot out.png]]\n", argv[0],
-                SCALE, TOL_IISPH);
+                SCALE, TOL_IISPH, PBF_COMPRESSION);
         return 2;
     }
-    /* IISPH by default: in the 20 m tank at 10k particles a simulated second costs it 4.8 CPU
-       seconds, PCISPH 14 and WCSPH 20 (README, "Real time in a game"); the check without
-       --solver goes through all three in key order */
+    /* IISPH by default: in the 20 m tank at 10k particles neither keeps up with real time; PBF
+       at its 2 % target gets 1.25 times further, at three times IISPH's compression (README,
+       "Real time in a game"); the check without --solver goes through all four in key order */
     d.solver = fixed >= 0 ? fixed : frames > 0 ? 0 : 2;
-    for (k = 0; k < 3 && frames > 0; ++k) {
+    for (k = 0; k < NSOLVER && frames > 0; ++k) {
         tal[k].ms_frame = (double*)malloc(sizeof(double) * (size_t)frames);
         tal[k].ms_sim = (double*)malloc(sizeof(double) * (size_t)frames);
         if (!tal[k].ms_frame || !tal[k].ms_sim) return 1;
@@ -701,7 +718,7 @@ int main(int argc, char** argv) {
             if (ev.type != SDL_KEYDOWN || frames > 0) continue;
             switch (ev.key.keysym.sym) {
             case SDLK_ESCAPE: running = 0; break;
-            case SDLK_1: case SDLK_2: case SDLK_3:
+            case SDLK_1: case SDLK_2: case SDLK_3: case SDLK_4:
                 if (!switch_solver(&d, (int)(ev.key.keysym.sym - SDLK_1))) running = 0;
                 break;
             case SDLK_p: d.pad.on = !d.pad.on; break;
@@ -710,10 +727,10 @@ int main(int argc, char** argv) {
             }
         }
         if (!running) break;
-        if (frames > 0) { /* without --solver: WCSPH, PCISPH, IISPH for a third each */
-            const int want = fixed >= 0 ? fixed : frame * 3 / frames;
+        if (frames > 0) { /* without --solver: WCSPH, PCISPH, IISPH, PBF for a quarter each */
+            const int want = fixed >= 0 ? fixed : frame * NSOLVER / frames;
             if (want != d.solver && !switch_solver(&d, want)) { status = 1; break; }
-            script_input(&d, frame, frames, fixed >= 0 ? 1 : 3);
+            script_input(&d, frame, frames, fixed >= 0 ? 1 : NSOLVER);
         } else {
             int mx, my;
             const Uint32 buttons = SDL_GetMouseState(&mx, &my);
@@ -738,6 +755,7 @@ int main(int argc, char** argv) {
             t->errors += s != SPH_OK;
             if (s == SPH_OK && d.w.stats.compression_avg > t->comp_max)
                 t->comp_max = d.w.stats.compression_avg;
+            if (s == SPH_OK) t->comp_sum += d.w.stats.compression_avg;
         }
         if (s != SPH_OK) { /* a demo must not crash: show why, start again */
             char why[64];
@@ -789,15 +807,16 @@ int main(int argc, char** argv) {
     }
 
     /* check mode: one line per solver that ran; exit status 1 on an error or an escape */
-    for (k = 0; k < 3; ++k) {
+    for (k = 0; k < NSOLVER; ++k) {
         const tally* t = &tal[k];
         if (t->frames == 0) continue;
         printf("realtime: %-6s particles %zu  frames %d  median %.1f ms/frame (sim %.1f ms)  "
                "steps %ld (%.1f/frame)  simulated %.3f s in %.3f s (cpu %.2f s)  factor %.3f  "
-               "compression <= %.2f %%  outside %zu  errors %d\n",
+               "compression mean %.2f %%, <= %.2f %%  outside %zu  errors %d\n",
                solver_arg[k], t->n, t->frames, median(t->ms_frame, t->frames),
                median(t->ms_sim, t->frames), t->steps, (double)t->steps / t->frames, t->simulated,
-               t->wall, t->cpu, t->wall > 0 ? t->simulated / t->wall : 0, 100 * t->comp_max,
+               t->wall, t->cpu, t->wall > 0 ? t->simulated / t->wall : 0,
+               100 * t->comp_sum / t->frames, 100 * t->comp_max,
                t->outside, t->errors);
         if (t->outside > 0 || t->errors > 0) status = 1;
     }
@@ -805,14 +824,14 @@ int main(int argc, char** argv) {
         if (d.reduced) printf("realtime: detail reduced %d time(s) to keep up with real time\n",
                               d.reduced);
         printf("realtime: scale %g (tank %g m x %g m, water %g m deep, spacing %.3g m), IISPH "
-               "tolerance %g, OMP_WAIT_POLICY=%s\n", scene_scale, len(TANK_W), len(TANK_H),
-               len(DEPTH), d.dx, d.tol_iisph, getenv("OMP_WAIT_POLICY") ? getenv("OMP_WAIT_POLICY") : "unset");
+               "tolerance %g, PBF compression %g, OMP_WAIT_POLICY=%s\n", scene_scale, len(TANK_W),
+               len(TANK_H), len(DEPTH), d.dx, d.tol_iisph, d.pbf_compression, getenv("OMP_WAIT_POLICY") ? getenv("OMP_WAIT_POLICY") : "unset");
         if (shot && status == 0) printf("realtime: screenshot %s\n", shot);
         printf("real-time factor %.3g at %zu particles, solver %s\n",
                run_wall > 0 ? run_sim / run_wall : 0, d.w.n,
-               fixed >= 0 ? solver_arg[fixed] : "wcsph+pcisph+iisph");
+               fixed >= 0 ? solver_arg[fixed] : "wcsph+pcisph+iisph+pbf");
     }
-    for (k = 0; k < 3; ++k) {
+    for (k = 0; k < NSOLVER; ++k) {
         free(tal[k].ms_frame);
         free(tal[k].ms_sim);
     }

@@ -84,8 +84,8 @@ run() { # run NAME ARGS...: NAME.png is the screenshot
     fi
 }
 
-for solver in wcsph pcisph iisph; do run "$solver" --solver "$solver"; done
-run switch --particles 3000 # WCSPH -> PCISPH -> IISPH, one third each
+for solver in wcsph pcisph iisph pbf; do run "$solver" --solver "$solver"; done
+run switch --particles 3000 # WCSPH -> PCISPH -> IISPH -> PBF, a quarter each
 if [ $fail -ne 0 ]; then
     echo "check_realtime: FAILED ($((SECONDS - start)) s)"
     exit 1

@@ -29,6 +29,7 @@ extern const th_test tests_compile[];
 extern const th_test tests_iisph[];
 extern const th_test tests_iisph_long[]; /* long runs: only with --long (make validate) */
 extern const th_test tests_dfsph[];
+extern const th_test tests_pbf[]; /* position based fluids (issue 17, item 6) */
 extern const th_test tests_pcisph[];
 extern const th_test tests_pcisph_long[];
 extern const th_test tests_operators[];

@@ -36,7 +36,7 @@ int th_taken(int status, int not_converged) {
 int th_not_converged(void) { return th_nc; }
 
 static const th_test* const th_tables[] = {tests_kernels, tests_grid, tests_operators, tests_world, tests_io, tests_save, tests_reliability, tests_wcsph,
-                                           tests_pcisph, tests_iisph, tests_dfsph, tests_compressible, tests_soc,
+                                           tests_pcisph, tests_iisph, tests_dfsph, tests_pbf, tests_compressible, tests_soc,
                                            tests_compile, tests_oom, tests_validation, tests_scenes,
                                            tests_hostile, tests_viscous, tests_layers, tests_rt};
 static const th_test* const th_long_tables[] = {tests_pcisph_long, tests_iisph_long,

@@ -629,6 +629,17 @@ static void scen_iisph(oom_ctx* C) {
     OOM(C, w, th_step(w, (sph_real)2e-3));
 }
 
+/* Position based fluids: its step predicts the positions before the neighbour search, and must
+   put them back when the search runs out of memory. */
+static void scen_pbf(oom_ctx* C) {
+    sph_world* w = &C->w;
+    sph_world_def def = oom_def2();
+    def.solver = SPH_SOLVER_PBF;
+    OOM_PART(C, oom_tank(C, &def, 0));
+    OOM(C, w, th_step(w, (sph_real)2e-3));
+    OOM(C, w, th_step(w, (sph_real)2e-3));
+}
+
 /* Compressible, 1D: Tait water, then two ideal gases (the internal energy array appears with
    particles present), unequal masses, closed by walls (multiphase walls: a wall pressure per
    phase). */
@@ -849,6 +860,7 @@ static void test_oom_pcisph_blocks(void) {
     oom_run_tol("pcisph_blocks", scen_pcisph_blocks, 0, 1);
 }
 static void test_oom_iisph(void) { oom_run("iisph", scen_iisph); }
+static void test_oom_pbf(void) { oom_run("pbf", scen_pbf); }
 static void test_oom_compressible(void) { oom_run("compressible_gas", scen_compressible); }
 static void test_oom_second_order(void) { oom_run("second_order", scen_second_order); }
 static void test_oom_second_order_midstep(void) {
@@ -922,6 +934,7 @@ const th_test tests_oom[] = {
     {"oom/pcisph_enhanced", test_oom_pcisph_enhanced},
     {"oom/pcisph_blocks", test_oom_pcisph_blocks},
     {"oom/iisph", test_oom_iisph},
+    {"oom/pbf", test_oom_pbf},
     {"oom/compressible_gas", test_oom_compressible},
     {"oom/second_order", test_oom_second_order},
     {"oom/second_order_midstep", test_oom_second_order_midstep},

@@ -50,7 +50,8 @@ static const sc_solver sc_solvers[] = {{"WCSPH", SPH_SOLVER_WCSPH, -1},
                                        {"PCISPH orig", SPH_SOLVER_PCISPH, 0},
                                        {"PCISPH enh", SPH_SOLVER_PCISPH, 1},
                                        {"IISPH", SPH_SOLVER_IISPH, -1},
-                                       {"DFSPH", SPH_SOLVER_DFSPH, -1}};
+                                       {"DFSPH", SPH_SOLVER_DFSPH, -1},
+                                       {"PBF", SPH_SOLVER_PBF, -1}};
 static const char* const sc_bp_names[] = {"extrapolate", "mirror", "zero"}; /* mirror: refused */
 static const char* sc_bp_name(int bp) { return bp < 0 ? "default" : sc_bp_names[bp]; }
 
@@ -380,6 +381,8 @@ static void sc_schemes(sc_scene sc, int dim, double dx, double duration, sc_expe
                 sc_mirror_refused(so, dim);
                 continue;
             }
+            /* PBF's walls carry no multiplier (zero wall pressure) whatever the scheme */
+            if (so->solver == SPH_SOLVER_PBF && bp != SPH_BP_ZERO) continue;
             r = sc_run(sc, so, bp, dim, dx, duration);
             CHECK_MSG(!r.silent_escape, "%s %s %dD %s: a particle crossed a wall unreported",
                       so->name, sc_bp_names[bp], dim, sc_names[sc]);

@@ -92,6 +92,7 @@ static void test_def_fields(void) {
         {"boundary_pressure", 21, SPH_SOLVER_WCSPH}, {"boundary_pressure", 21, SPH_SOLVER_PCISPH},
         {"boundary_pressure", 21, SPH_SOLVER_IISPH}, {"boundary_pressure", 21, SPH_SOLVER_DFSPH},
         {"boundary_pressure", 21, SPH_SOLVER_COMPRESSIBLE},
+        {"boundary_pressure", 21, SPH_SOLVER_PBF},
     };
     size_t c;
     (void)nan_;
