@@ -166,7 +166,8 @@ static void fzl_edit(fzc_reader* r, unsigned char* b, size_t* size) {
         const uint32_t u = isfinite(v) && fabs(v) < 4e9 ? (uint32_t)(int64_t)v : 0xffffffffu;
         memcpy(b + off, &u, 4);
     } else if (kind == 4) {
-        b[off] = (unsigned char)((int64_t)(isfinite(v) ? v : 255) & 255);
+        /* a finite v beyond int64_t's range would make the conversion undefined */
+        b[off] = (unsigned char)((int64_t)(isfinite(v) && fabs(v) < 9e18 ? v : 255) & 255);
     } else if (kind == 5) {
         *size = off + 8; /* truncated (the checksum is recomputed over what is left) */
     }
