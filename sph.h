@@ -4371,6 +4371,26 @@ static sph_status sph__stage_neighbors(sph_world* w) {
     return SPH_OK;
 }
 
+/* sum_b V_b w(|x - x_b| / h) over fluid particle i's wall list at position x (w without the
+   kernel's norm): the walls' share of a summation density (the density stage, PBF's last pass,
+   check_walls' wall fraction); with fw_out set, each pair's grad W factor from the same q. */
+SPH__INLINE sph_real sph__wall_sum(const sph__ctx* c, size_t i, const sph_real* x, const int D,
+                                   const int form, sph_real* fw_out) {
+    sph_real sum = 0, q;
+    size_t kk, k0 = c->fb->begin[i], k1 = k0 + c->fb->count[i];
+    int k;
+    for (kk = k0; kk < k1; ++kk) {
+        const size_t b = c->fb->idx[kk];
+        sph_real d[3] = {0, 0, 0}, r2 = 0;
+        sph__delta_vec(c, x, c->bx + b * (size_t)D, d, D);
+        SPH__FOR_K(D, r2 += d[k] * d[k]);
+        q = sph__sqrt(r2) * c->k.inv_h;
+        sum += c->bvol[b] * sph__kw(form, q);
+        if (fw_out) fw_out[kk] = c->k.norm_g * sph__kf(form, q);
+    }
+    return sum;
+}
+
 /* rho_i of one particle; D and the kernel form compile-time constants where the stage knows
    them (the loops over k unroll and d[] stays in registers: 3D IISPH's density stage x2). With
    c->ff_fw_out set (IISPH, DFSPH) it also keeps every pair's grad W factor from the same q, for
@@ -4391,19 +4411,7 @@ SPH__INLINE sph_real sph__density_one(const sph__ctx* c, size_t i, const int D, 
         sum += (c->m ? c->m[j] : c->m0) * sph__kw(form, q);
         if (c->ff_fw_out) c->ff_fw_out[kk] = c->k.norm_g * sph__kf(form, q);
     }
-    if (c->has_b) {
-        k0 = c->fb->begin[i];
-        k1 = k0 + c->fb->count[i];
-        for (kk = k0; kk < k1; ++kk) {
-            const size_t b = c->fb->idx[kk];
-            sph_real d[3] = {0, 0, 0}, r2 = 0;
-            sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
-            SPH__FOR_K(D, r2 += d[k] * d[k]);
-            q = sph__sqrt(r2) * c->k.inv_h;
-            sumb += c->bvol[b] * sph__kw(form, q);
-            if (c->fb_fw_out) c->fb_fw_out[kk] = c->k.norm_g * sph__kf(form, q);
-        }
-    }
+    if (c->has_b) sumb = sph__wall_sum(c, i, xi, D, form, c->fb_fw_out);
     return (mi * w0 + c->k.norm_w * (sum + c->pc[c->ph[i]].rho0 * sumb)) / S;
 }
 
@@ -5084,18 +5092,7 @@ static int sph__incompressible(int solver) {
    sum, so a particle deep inside a lattice wall has 1 and one on a flat wall's face 0.5), from
    the step's fluid->wall lists at the particle's position now. */
 static sph_real sph__wall_fraction(const sph__ctx* c, const sph_real* xi, size_t i, sph_real S) {
-    const int D = c->dim;
-    sph_real sum = 0;
-    size_t kk, k0 = c->fb->begin[i], k1 = k0 + c->fb->count[i];
-    for (kk = k0; kk < k1; ++kk) {
-        const size_t b = c->fb->idx[kk];
-        sph_real d[3] = {0, 0, 0}, r2 = 0;
-        int k;
-        sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
-        for (k = 0; k < D; ++k) r2 += d[k] * d[k];
-        sum += c->bvol[b] * sph__kw(c->k.form, sph__sqrt(r2) * c->k.inv_h);
-    }
-    return sum * c->k.norm_w / S;
+    return sph__wall_sum(c, i, xi, c->dim, c->k.form, NULL) * c->k.norm_w / S;
 }
 
 
@@ -7772,17 +7769,7 @@ SPH__INLINE void sph__pbf_velocity_one(sph_world* w, const sph__ctx* c, const sp
             SPH__FOR_K(D, av[k] += f * (vi[k] - vj[k]));
         }
     }
-    if (c->has_b) {
-        k0 = c->fb->begin[i];
-        k1 = k0 + c->fb->count[i];
-        for (kk = k0; kk < k1; ++kk) {
-            const size_t b = c->fb->idx[kk];
-            sph_real d[3] = {0, 0, 0}, r2 = 0;
-            sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
-            SPH__FOR_K(D, r2 += d[k] * d[k]);
-            sumb += c->bvol[b] * sph__kw(form, sph__sqrt(r2) * c->k.inv_h);
-        }
-    }
+    if (c->has_b) sumb = sph__wall_sum(c, i, xi, D, form, NULL);
     w->rho[i] = (mi * P->w0 + c->k.norm_w * (sum + ph->rho0 * sumb)) * P->inv_s;
     SPH__FOR_K(D, vo[i * (size_t)D + (size_t)k] = vi[k] + cx * c->k.norm_w * xs[k] + dt * av[k]);
 }

@@ -176,23 +176,31 @@ static void test_tensile_correction(void) {
    2 s through sph_advance with the library's defaults and PBF: no particle leaves the box, no
    step fails, the mean compression at the frame ends stays below 2 def.pbf_compression (its
    measured mean and largest are printed, with the late largest speed in sqrt(g H)). */
-static void test_tank_at_rest(void) {
+/* The tank of the two tests below: 1 x 0.8 m of water in a 1 m box, dx = 0.02, PBF, started by
+   sph_set_hydrostatic; compression 0 keeps the library's def.pbf_compression. */
+static sph_world_def pbf_tank(sph_world* w, double compression) {
     sph_world_def def = sph_world_def_default(2);
-    sph_world w;
     sph_phase ph;
     sph_real lo[2] = {0, 0}, fluid[2] = {1, (sph_real)0.8}, box[2] = {1, 1};
-    double comp_sum = 0, comp_max = 0, v_late = 0, ymax = 0;
-    int f, frames = 40, outside = 0;
-    size_t i;
     memset(&ph, 0, sizeof ph);
     ph.rest_density = 1000;
     def.spacing = (sph_real)0.02;
     def.solver = SPH_SOLVER_PBF;
-    CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
-    CHECK(sph_world_add_phase(&w, &ph) == 0);
-    CHECK_EQ_INT(sph_fill_box(&w, 0, lo, fluid), SPH_OK);
-    CHECK_EQ_INT(sph_add_wall_box(&w, lo, box, 0, 0), SPH_OK);
-    CHECK_EQ_INT(sph_set_hydrostatic(&w), SPH_OK);
+    if (compression > 0) def.pbf_compression = (sph_real)compression;
+    CHECK_EQ_INT(sph_world_init(w, &def), SPH_OK);
+    CHECK(sph_world_add_phase(w, &ph) == 0);
+    CHECK_EQ_INT(sph_fill_box(w, 0, lo, fluid), SPH_OK);
+    CHECK_EQ_INT(sph_add_wall_box(w, lo, box, 0, 0), SPH_OK);
+    CHECK_EQ_INT(sph_set_hydrostatic(w), SPH_OK);
+    return def;
+}
+
+static void test_tank_at_rest(void) {
+    sph_world w;
+    const sph_world_def def = pbf_tank(&w, 0);
+    double comp_sum = 0, comp_max = 0, v_late = 0, ymax = 0;
+    int f, frames = 40, outside = 0;
+    size_t i;
     for (f = 1; f <= frames; ++f) {
         sph_status s = sph_advance(&w, (sph_real)0.05);
         CHECK_MSG(s == SPH_OK, "%s", w.error);
@@ -227,23 +235,11 @@ static void test_tank_at_rest(void) {
    compression swings between 0.4 % and 5 % (a soft fluid breathing). Held to: every frame returns SPH_OK, retries happened,
    nothing leaves the box, the mass is exact. */
 static void test_retries_recover(void) {
-    sph_world_def def = sph_world_def_default(2);
     sph_world w;
-    sph_phase ph;
-    sph_real lo[2] = {0, 0}, fluid[2] = {1, (sph_real)0.8}, box[2] = {1, 1};
     double m0;
     int f, retries = 0, outside = 0;
     size_t i;
-    memset(&ph, 0, sizeof ph);
-    ph.rest_density = 1000;
-    def.spacing = (sph_real)0.02;
-    def.solver = SPH_SOLVER_PBF;
-    def.pbf_compression = (sph_real)0.1;
-    CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
-    CHECK(sph_world_add_phase(&w, &ph) == 0);
-    CHECK_EQ_INT(sph_fill_box(&w, 0, lo, fluid), SPH_OK);
-    CHECK_EQ_INT(sph_add_wall_box(&w, lo, box, 0, 0), SPH_OK);
-    CHECK_EQ_INT(sph_set_hydrostatic(&w), SPH_OK);
+    pbf_tank(&w, 0.1);
     m0 = sph_world_mass(&w);
     for (f = 0; f < 12; ++f) {
         const sph_status s = sph_advance(&w, (sph_real)0.05);
