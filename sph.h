@@ -157,9 +157,11 @@ int main(void) {
    25 x 25, its exact kinetic energy decaying as exp(-4 pi^2 nu t)) keeps WCSPH's energy within
    3.5 % of the exact until t = 0.2 s; then the lattice breaks up along the vortex's stretching
    directions (no background pressure, no particle shifting: the disordered particles
-   dissipate), and over 0.5 s the energy decays 4.2 (WCSPH), 2.9 (IISPH), 3.0 (DFSPH, PCISPH)
-   times as fast as it should. The default artificial viscosity is not the cause: with
-   alpha = 0 the rates change by at most 0.11 of the exact rate (4.22, 2.78, 3.09, 3.00). It
+   dissipate), and over 0.5 s the energy decays 4.2 (WCSPH), 3.1 (IISPH, DFSPH), 2.4 (original
+   PCISPH) times as fast as it should (means of runs in 0.05 s and 0.1 s frames: where the steps
+   land alone moves one run's rate by up to 0.3). The default artificial viscosity is not the
+   cause: with alpha = 0 the rates are 4.26, 3.01, 2.96 and 2.27, at most 0.15 of the exact
+   rate from the alpha = 0.02 ones (tests/test_viscous.c). It
    acts only on approaching pairs and is worth about alpha c0 h / 16 (6 % of nu there); it stays
    at 0.02 because it damps the acoustic noise of WCSPH's equation of state and of impacts (the
    dam-break and tank tests run with it); set def.alpha = 0 for a viscous flow that needs none.
@@ -1178,9 +1180,10 @@ typedef struct sph__private {
                                        current sub-step's start [1] (rollback)                      */
     size_t snap_cap[2];             /* bytes                                                        */
     int cold_start;                 /* sph_advance's retry: pressure solves start from 0        */
-    double correct_fraction;        /* PCISPH, IISPH: the fraction of the compression standing at
-                                       the step's start that the step corrects, dt / dt_rule when
-                                       sph_advance shortened the step below the rule, else 1    */
+    double correct_fraction;        /* PCISPH, IISPH, DFSPH: the fraction of the compression
+                                       standing at the step's start that the step corrects:
+                                       sph_advance's dt_factor while a retry has shortened the
+                                       step below the rule, else 1                              */
 } sph__private;
 
 /* The world: a caller-owned plain struct. Read the arrays directly; positions and velocities may
@@ -5549,10 +5552,13 @@ static sph_status sph__integrate(sph_world* w, const sph__ctx* c, sph_real kv, s
    so a standing compression delta is removed by a velocity of about delta dx / dt: the smaller the step, the
    harder the kick. When sph_advance retries a failed step at half the size, that kick would
    double and the retry fail harder (with an ever smaller step it grows without bound). A step
-   shortened below the solver's rule dt_rule therefore corrects only dt / dt_rule of the
+   that a retry shortened to dt_factor of the rule therefore corrects only dt_factor of the
    standing compression (as a Baumgarte-stabilised constraint: the correction velocity stays that
-   of the rule's step) and the rest in the steps that follow. sph_step_* called directly correct
-   all of it. */
+   of the rule's step) and the rest in the steps that follow. A step shortened only to land on the
+   end of sph_advance's call corrects all of it: leaving the rest made the first step of the next
+   call face it together with its own, and IISPH's 2D tank at rest (dx 0.02, 0.05 s frames)
+   stopped at max_iterations there about once a frame. sph_step_* called directly correct all of
+   it. */
 static sph_real sph__standing_keep(const sph_world* w) {
     const double f = w->priv.correct_fraction;
     return f > 0 && f < 1 ? (sph_real)(1 - f) : 0;
@@ -5672,11 +5678,16 @@ static void sph__record_nonpressure(sph_world* w) {
     w->stats.a_np_max = sqrt(m);
 }
 
-/* The warm start of the pressure solves: def.warm_start times the last pressure, except in a
-   step that sph_advance retries after a failure. The pressure of the failed step's start is part
-   of what failed: a corner particle whose walls extrapolate its own pressure can carry a
-   pressure that, half of it warm-started, blows the retry up at any dt (enhanced PCISPH's dam
-   break failed 13 retries down to dt = 4e-9 s); the retry starts from p = 0. */
+/* The warm start of the pressure solves: def.warm_start times the last pressure, except from the
+   second retry in a row of a step sph_advance is retrying. The pressure of the failed step's start
+   can be part of what failed: a corner particle whose walls extrapolate its own pressure can carry
+   a pressure that, half of it warm-started, blows the retry up at any dt (enhanced PCISPH's dam
+   break failed 13 retries down to dt = 4e-9 s); such a retry starts from p = 0. The first retry
+   keeps the warm start: from p = 0 a solve meets the mean-compression tolerance long before it
+   has rebuilt the hydrostatic pressure (a uniform sag compresses only the bottom rows), so the
+   column fell for a step at every retry. IISPH's 2D tank at rest (1 x 0.8 m, dx 0.02, 0.05 s
+   frames) retried about once a frame, and with cold first retries its speed late in 3 s stayed
+   near 0.1 sqrt(g H). */
 static sph_real sph__warm(const sph_world* w) { return w->priv.cold_start ? 0 : w->def.warm_start; }
 
 /* The end of an iterative solve above its tolerance: the step was taken with the last pressure,
@@ -8308,8 +8319,9 @@ static void sph__snapshot_restore(sph_world* w, int slot) {
 }
 
 /* The step control of sph_advance (DESIGN: "the robust integrator"):
-     dt = dt_factor * sph_stable_dt, shortened to land exactly on the end (a remainder under two
-          steps is split in halves);
+     dt = dt_factor * sph_stable_dt, shortened to land exactly on the end: the remainder of the
+          call is split into equal steps no longer than that (a lone short last step made the
+          pressure solves fail the step after it: see sph__standing_keep);
      a sub-step that fails with SPH_ERR_UNSTABLE (blow-up, runaway, a particle through a wall or
           moving too far) or SPH_ERR_NOT_CONVERGED is undone bit for bit and retried with half
           the step (dt_factor halves), at most SPH__RETRIES times in a row;
@@ -8365,7 +8377,7 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
         /* a remainder within rounding of one step is that step (sph_advance(w, sph_stable_dt(w))
            came out an ulp above the step and was split into two halves) */
         if (remaining <= dt * (1 + 1e-5)) { dt = remaining; last = 1; }
-        else if (remaining < 2 * dt) dt = 0.5 * remaining; /* no sliver of a last step */
+        else dt = remaining / ceil(remaining / dt); /* equal steps to the end: no sliver */
         if (dt < 1e-12 * (double)duration && !last) {
             double t = w->time;
             sph__snapshot_restore(w, 0);
@@ -8390,8 +8402,8 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
             }
         }
         ++substeps;
-        w->priv.correct_fraction = fmin(1.0, dt / dt_stable);
-        w->priv.cold_start = in_row > 0;
+        w->priv.correct_fraction = fmin(1.0, w->stats.dt_factor);
+        w->priv.cold_start = in_row > 1;
         s = sph_step(w, (sph_real)dt);
         iterations += w->stats.iterations;
         w->priv.correct_fraction = 1;
