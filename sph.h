@@ -1343,7 +1343,7 @@ SPHDEF sph_real sph_stable_dt(sph_world* w, sph_solver solver);
 SPHDEF sph_status sph_step(sph_world* w, sph_real dt);
 /* Advances by duration [s] in sub-steps of the stable time step (what a game calls per frame);
    the robust integrator. duration finite and >= 0. Each sub-step is dt_factor * sph_stable_dt,
-   shortened to land exactly on the end (a remainder under two steps is split in halves). A
+   shortened to land exactly on the end (the call's remainder split into equal steps). A
    sub-step that fails with SPH_ERR_UNSTABLE (blow-up, runaway speed, a particle moving more than
    def.max_displacement or inside a wall) or SPH_ERR_NOT_CONVERGED is undone bit for bit and
    retried at half the step, up to 12 times in a row; dt_factor grows back by 1.1 per successful
