@@ -473,6 +473,24 @@ static void test_tank_2d_rests(void) {
     }
 }
 
+/* The same 2D tank for 10 s (make validate): the incompressible solvers come to rest, below
+   the issue's 1 % of sqrt(g H) over the last half second. Measured: IISPH 0.0013, DFSPH 0.0039,
+   original PCISPH 0.0040 (before the frame-landing change: IISPH 0.054, DFSPH 0.051, still
+   sloshing). Not asserted, printed: WCSPH 0.019, enhanced PCISPH 0.014 and PBF 0.011 keep a
+   jitter of 1-2 % (WCSPH: acoustic waves of its equation of state). */
+static void test_tank_2d_comes_to_rest(void) {
+    int si;
+    for (si = 0; si < (int)(sizeof sc_solvers / sizeof sc_solvers[0]); ++si) {
+        const sc_solver* so = &sc_solvers[si];
+        const int held = so->solver == SPH_SOLVER_IISPH || so->solver == SPH_SOLVER_DFSPH ||
+                         (so->solver == SPH_SOLVER_PCISPH && so->pcisph == 0);
+        const sc_result r = sc_run(SC_TANK, so, -1, 2, 0.04, 10.0);
+        CHECK_MSG(r.status == SPH_OK, "%s: failed at t = %.2f s", so->name, r.t_end);
+        CHECK_EQ_INT(r.escaped, 0);
+        if (held) CHECK_LE(r.v_late / r.v_ref, 0.01);
+    }
+}
+
 static void test_schemes_2d_long(void) {
     sc_schemes(SC_TANK, 2, 0.04, 1.5, SC_REPORTED);
     sc_schemes(SC_DAM, 2, 0.04, 1.0, SC_REPORTED);
@@ -504,6 +522,7 @@ const th_test tests_scenes_long[] = {{"long/scenes/tank_2d", test_tank_2d_long},
                                      {"long/scenes/tank_3d", test_tank_3d_long},
                                      {"long/scenes/dam_3d", test_dam_3d_long},
                                      {"long/scenes/tank_3d_settles", test_tank_3d_settles},
+                                     {"long/scenes/tank_2d_comes_to_rest", test_tank_2d_comes_to_rest},
                                      {"long/scenes/schemes_2d", test_schemes_2d_long},
                                      {"long/scenes/schemes_3d", test_schemes_3d_long},
                                      {0, 0}};
