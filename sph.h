@@ -432,7 +432,8 @@ int main(void) {
    (without it 2.7 % too steep in every layer). Measured (tests/test_layers.c: 1000/500/100
    kg/m^3, 0.2 m each, 0.6 m wide, 20 across, sph_set_hydrostatic then sph_advance; largest speed
    over the last second against sqrt(g H), layer- and time-averaged pressure against the layered
-   profile p(0)): enhanced PCISPH after 2 s 0.49 % and 0.63 %, WCSPH after 0.5 s multiphase 0.96 %
+   profile p(0)): enhanced PCISPH after 2 s 0.49 % and 0.63 % (float 1.08 % and 0.68 %: its motion
+   after the first second depends on round-off), WCSPH after 0.5 s multiphase 0.96 %
    and 0.73 %, interface 0.50 % and 0.26 %; no particle past its layer's interface. After 10 s
    at 30 across (over the last second): WCSPH multiphase 0.34 % and 0.92 % (spread 0.12 dx),
    interface with continuity 0.25 % and 0.57 %, with particle density 4.7 % and 0.51 %, enhanced
@@ -447,7 +448,8 @@ int main(void) {
    is for interfaces that should move, see WCSPH), the original PCISPH, IISPH, DFSPH and PBF
    (summation density, or PBF's constraint on it, smears the mass jump: ratios near 1 only). On
    the column they fail with SPH_ERR_UNSTABLE from sph_advance (WCSPH symmetric with particle
-   density, multiphase with continuity, IISPH, DFSPH; the original PCISPH within a few steps),
+   density, multiphase with continuity, IISPH, DFSPH; the original PCISPH within a few steps,
+   tests/test_pcisph.c),
    or run without resting: WCSPH symmetric with continuity 7 % and PBF 72 % of sqrt(g H) after
    0.5 s. None loses a particle silently (tests/test_layers.c checks every frame). Gases and
    1000:1 interfaces: the compressible step (SOLVER: COMPRESSIBLE).
