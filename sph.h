@@ -124,9 +124,8 @@ int main(void) {
    about 1 %. Density by continuity (default) with delta-SPH diffusion (Molteni & Colagrossi
    2009, delta = 0.1), by summation (negative pressures then clamped), or by Ott & Schnetter's
    particle-density continuity for phases of very different density. Phases: with particle
-   density, the multiphase (or interface) pressure gradient holds layers at rest (a 1000/500/100
-   kg/m^3 column at 20 across after 2 s: 0.9 % of sqrt(g H), pressure within 2.3 %,
-   tests/test_layers.c), while SPH_PGRAD_DIFFERENCE lets buoyancy-driven interfaces move as they should (Rayleigh-Taylor
+   density, the multiphase (or interface) pressure gradient holds layers at rest (see PHASES),
+   while SPH_PGRAD_DIFFERENCE lets buoyancy-driven interfaces move as they should (Rayleigh-Taylor
    growth within 7 % of the viscous theory at Atwood 0.5 and 0.29, where the antisymmetric forms
    grow 3-10 times too slowly, tests/test_rt.c; it fails, reported, on the 10:1 column); delta-SPH
    diffuses pressure, not rho/rho0, across a phase interface. Viscosity: Monaghan's
@@ -193,7 +192,10 @@ int main(void) {
    field. With density ratios of 0.2 and below, or interfaces that mix (Rayleigh-Taylor), choose
    def.density = SPH_DENSITY_PARTICLE (Ott & Schnetter 2003): the thesis' continuity equation lets a
    light particle at an interface take its heavy neighbours' masses (the tests show the 0.2 tank
-   failing with it and holding with particle density). The original PCISPH cannot hold two phases
+   failing with it and holding with particle density). With Stormer-Verlet the predicted density
+   is constrained with 0.47 v^n + 0.53 v* rather than the midpoint velocity, which would leave the
+   compression rate of the last step undamped (derived in >>pcisph; on the layered column of
+   PHASES it took the speed from 3.9 % to 0.5 % of sqrt(g H)). The original PCISPH cannot hold two phases
    of different density at all (summation smears the mass jump): it fails within a few steps and
    says so. The original's step is also bounded by its largest pressure, dt <= 0.25 h /
    sqrt(p_max / rho0): its correction at the predicted positions diverges above (derived in
@@ -420,6 +422,39 @@ int main(void) {
    Ott & Schnetter's advection, sound-wave and air | Diesel shock-tube tests, Toro's Riemann
    solutions and a 1000:1 interface at rest (tests/test_compressible.c). With multiphase walls each
    phase sees a wall pressure extrapolated from its own particles only.
+
+   PHASES (several fluids of different rest density)
+   Recommended for layered or mixing liquids with density ratios down to 0.1: particle-density
+   continuity (def.density = SPH_DENSITY_PARTICLE, Ott & Schnetter 2003 eq. 11) with
+     - enhanced PCISPH, sph_world_def_pcisph(&def, 1), which brings the multiphase gradient; or
+     - WCSPH with def.pressure_grad = SPH_PGRAD_MULTIPHASE (eq. 12) or SPH_PGRAD_INTERFACE (Hu &
+       Adams 2006).
+   Both gradients are divided by the kernel gradient's lattice moment (0.974 for Wendland C2 at
+   h = 1.3 dx in 2D), so that the pressure they balance with gravity is the hydrostatic one
+   (without it 2.7 % too steep in every layer). Measured (tests/test_layers.c: 1000/500/100
+   kg/m^3, 0.2 m each, 0.6 m wide, 20 across, sph_set_hydrostatic then sph_advance; largest speed
+   over the last second against sqrt(g H), layer- and time-averaged pressure against the layered
+   profile p(0)): enhanced PCISPH after 2 s 0.49 % and 0.63 % (float 1.08 % and 0.68 %: its motion
+   after the first second depends on round-off), WCSPH after 0.5 s multiphase 0.96 %
+   and 0.73 %, interface 0.50 % and 0.26 %; no particle past its layer's interface. After 10 s
+   at 30 across (over the last second): WCSPH multiphase 0.34 % and 0.92 % (spread 0.12 dx),
+   interface with continuity 0.25 % and 0.57 %, with particle density 4.7 % and 0.51 %, enhanced
+   PCISPH 0.29 % and 3.9 % (its solve hits max_iterations in deep columns, and the retries
+   restart the pressure from 0). Not met: staying below 1 % of sqrt(g H) throughout the 10 s.
+   After coming to rest (0.2-0.5 % at 4-6 s, 20 across) episodes of 2-3 % follow (a row sliding
+   along the floor or along the lower interface), as in a one-phase tank of the same depth and
+   spacing (WCSPH 4.6 %, enhanced PCISPH 3.9 % within 10 s): a property of the walls and
+   solvers, not of the phases. Not for phases of different
+   density: the symmetric gradient, the multiphase gradient with the mass continuity equation (a
+   light particle takes its heavy neighbours' masses), SPH_PGRAD_DIFFERENCE on a 10:1 column (it
+   is for interfaces that should move, see WCSPH), the original PCISPH, IISPH, DFSPH and PBF
+   (summation density, or PBF's constraint on it, smears the mass jump: ratios near 1 only). On
+   the column they fail with SPH_ERR_UNSTABLE from sph_advance (WCSPH symmetric with particle
+   density, multiphase with continuity, IISPH, DFSPH; the original PCISPH within a few steps,
+   tests/test_pcisph.c),
+   or run without resting: WCSPH symmetric with continuity 7 % and PBF 72 % of sqrt(g H) after
+   0.5 s. None loses a particle silently (tests/test_layers.c checks every frame). Gases and
+   1000:1 interfaces: the compressible step (SOLVER: COMPRESSIBLE).
 
    WHAT IT DOES NOT DO (yet)
    No surface tension, no turbulence model, no rigid-body coupling (boundaries move kinematically),
@@ -1173,6 +1208,8 @@ typedef struct sph__private {
     int b_dirty;                    /* boundary particles changed since the last boundary grid     */
     int have_mass;                  /* w->mass is set                                               */
     sph_real lattice_sum;           /* dx^dim sum_j W(x_j) over a square lattice of spacing dx     */
+    sph_real lattice_grad;          /* the gradient's first moment on that lattice, see
+                                       sph__lattice_grad                                         */
     size_t full_count;              /* neighbours of a particle inside a full square lattice      */
     sph_real wall_fraction_max;     /* check_walls: wall volume fraction of a particle on the
                                        first layer of a flat lattice wall                          */
@@ -2995,6 +3032,27 @@ static sph_real sph__lattice_sum(const sph_kernel* k, sph_real dx) {
     return (sph_real)(sum * vol);
 }
 
+/* The first moment of the kernel gradient over a square lattice of spacing dx (the particle at
+   the origin, its neighbours at x_j), -dx^dim / dim sum_j |x_j| dW/dr(|x_j|): an SPH gradient
+   sum_j V_j (A_j - A_i) grad W_ij of a linear A = a . x gives this times a on the lattice (the
+   moment matrix sum_j V_j (x_j - x_i) grad W_ij^T is this times the identity, by the lattice's
+   symmetry). Wendland C2 at h = 1.3 dx: 0.9739 in 2D, below 1 because the lattice sum
+   replaces the integral: the hydrostatic pressure that the gradient balances with gravity is
+   then 2.7 % too steep (sph__ctx_init's pg_norm). */
+static sph_real sph__lattice_grad(const sph_kernel* k, sph_real dx) {
+    const int R = (int)(k->radius / dx) + 1, D = k->dim;
+    double sum = 0, vol = 1;
+    int i, j, l;
+    for (i = 0; i < D; ++i) vol *= (double)dx;
+    for (i = -R; i <= R; ++i)
+        for (j = (D > 1 ? -R : 0); j <= (D > 1 ? R : 0); ++j)
+            for (l = (D > 2 ? -R : 0); l <= (D > 2 ? R : 0); ++l) {
+                const double r = (double)dx * sqrt((double)(i * i + j * j + l * l));
+                sum -= r * (double)sph_kernel_dwdr(k, (sph_real)r);
+            }
+    return (sph_real)(sum * vol / D);
+}
+
 /* The wall volume fraction that check_walls allows (see sph__wall_fraction): that of a particle
    half a spacing past the first layer of a flat lattice wall, 1 dx past its face (0.94 for
    Wendland C2 at h = 1.3 dx in 2D and 3D). A fluid particle stays well below it: 0.5 on a face,
@@ -3081,6 +3139,7 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
                          "sph_world_def.spacing = %g: h = %g m gives kernel constants that are "
                          "not finite and > 0 in sph_real", (double)def->spacing, (double)w->h);
     w->priv.lattice_sum = sph__lattice_sum(&w->kernel, w->dx);
+    w->priv.lattice_grad = sph__lattice_grad(&w->kernel, w->dx);
     w->priv.wall_fraction_max = sph__wall_fraction_limit(&w->kernel, w->dx) / w->priv.lattice_sum;
     if (def->boundary_gamma == 0) w->def.boundary_gamma = sph__akinci_gamma(&w->kernel, w->dx);
     {
@@ -3877,6 +3936,8 @@ typedef struct sph__ctx {
                                   average of the fluid's (solvers without one; Enhanced PCISPH
                                   2018 sec. 3.2.3)                                               */
     sph_real alpha, beta, delta, visc_k;
+    sph_real pg_norm;          /* 1 / the lattice gradient moment for the multiphase and interface
+                                  pressure gradients (see sph__ctx_init), else 1                */
     sph_real* lapc;            /* laminar viscosity, Morris form: 1 / m_i per fluid particle
                                   (sph__stage_visc_norm fills it before each viscous pass)      */
     sph_real g[3];
@@ -3926,6 +3987,18 @@ static void sph__ctx_init(sph_world* w, sph__ctx* c) {
     }
     c->density = (int)w->def.density;
     c->pgrad = (int)w->def.pressure_grad;
+    /* The multiphase and interface gradients of a layered column at rest balance gravity with a
+       pressure 1 / M times too steep, M = sph__lattice_grad (0.974: 2.7 % at the bottom of any
+       column, in every solver; measured on tests/test_layers.c's 1000/500/100 column, WCSPH,
+       20 across: rows 2.0-2.9 % of the bottom pressure above the layered profile in the heavy
+       layer). Dividing their pair terms by M makes the gradient of a linear pressure exact on
+       the lattice (the same correction, for the gradient, as the density's division by the
+       lattice sum): the rows then within 0.2 % away from the interfaces (1.2 % on the row next to
+       one). The symmetric form, the default of one-phase scenes, is left as it was. */
+    c->pg_norm = 1;
+    if ((c->pgrad == SPH_PGRAD_MULTIPHASE || c->pgrad == SPH_PGRAD_INTERFACE) &&
+        w->priv.lattice_grad > 0)
+        c->pg_norm = 1 / w->priv.lattice_grad;
     c->noslip = w->def.wall == SPH_WALL_NO_SLIP;
     c->bp_mode = (int)w->def.boundary_pressure;
     c->eos_walls = w->priv.solver == SPH_SOLVER_WCSPH || w->priv.solver == SPH_SOLVER_COMPRESSIBLE;
@@ -4763,9 +4836,9 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
             if (pgrad == SPH_PGRAD_SYMMETRIC)
                 s = -mj * (pi_r2 + ((flags & SPH__CACHED) ? c->pr2[j]
                                     : (fast && c->pr2c) ? c->pr2c[j] : pj / (rhoj * rhoj)));
-            else if (pgrad == SPH_PGRAD_MULTIPHASE) s = -mj * (pi + pj) * inv_rhoi / rhoj;
+            else if (pgrad == SPH_PGRAD_MULTIPHASE) s = -mj * (pi + pj) * inv_rhoi / rhoj * c->pg_norm;
             else if (pgrad == SPH_PGRAD_DIFFERENCE) s = -mj * (pj - pi) * inv_rhoi / rhoj;
-            else s = sph__pgrad_interface(mi, rhoi, pi, mj, rhoj, pj);
+            else s = sph__pgrad_interface(mi, rhoi, pi, mj, rhoj, pj) * c->pg_norm;
         }
         if (flags & SPH__VISCOUS) {
             if (laminar) {
@@ -4825,9 +4898,9 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
                                     : c->bp_mode == SPH_BP_MIRROR    ? pi
                                                                      : 0;
                 if (pgrad == SPH_PGRAD_SYMMETRIC) s = -psi * (pi_r2 + pb / (rhob * rhob));
-                else if (pgrad == SPH_PGRAD_MULTIPHASE) s = -psi * (pi + pb) * inv_rhoi / rhob;
+                else if (pgrad == SPH_PGRAD_MULTIPHASE) s = -psi * (pi + pb) * inv_rhoi / rhob * c->pg_norm;
                 else if (pgrad == SPH_PGRAD_DIFFERENCE) s = -psi * (pb - pi) * inv_rhoi / rhob;
-                else s = sph__pgrad_interface(mi, rhoi, pi, psi, rhob, pb);
+                else s = sph__pgrad_interface(mi, rhoi, pi, psi, rhob, pb) * c->pg_norm;
             }
             if ((flags & SPH__VISCOUS) && c->noslip && (laminar || c->av)) {
                 const sph_real* vw = c->bvw + b * (size_t)D;
@@ -6478,10 +6551,30 @@ SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt) {
          until a standing compression near the tolerance carries it (an underdamped, WCSPH-like
          equilibrium). The enhanced preset warm-starts from half the last pressure, as IISPH;
      (d) with Stormer-Verlet the positions drift half a step, the correction runs at the half step
-         and constrains the density at the end of the step, predicted by the midpoint rule
-         rho* = rho^n + dt R(x^{n+1/2}, (v^n + v*)/2) (or summation at x^{n+1/2} + dt/2 v*), which
-         responds to a velocity change with half the weight of the Euler prediction, so the gain
-         is doubled; the velocity kick and the second drift use the final pressure. */
+         and constrains the density at the end of the step, predicted at x^{n+1/2} with the
+         velocity beta v^n + (1 - beta) v*, beta = SPH__PCI_BETA = 0.47 (summation: at x^{n+1/2}
+         + dt/2 v*), which sees 1 - beta of a velocity change (summation: half), so the gain is
+         divided by that; the velocity kick and the second drift use the final pressure, and the
+         density integrates by the midpoint rule, rho^{n+1} = rho^n + dt R(x^{n+1/2}, (v^n +
+         v^{n+1})/2). Why off-centre (as the theta-methods' theta > 1/2 damps the two-step mode
+         of Crank-Nicolson): per mode, with e = dt R(v) and d = rho - rho0, the constraint gives
+         e' = -(d + beta e)/(1 - beta) and d' = d + (e + e')/2, whose eigenvalues have the
+         product (1 - 2 beta)/(2 (1 - beta)) and the sum 1 - (1/2 + beta)/(1 - beta): at the
+         midpoint, beta = 1/2, they are 0 and -1, so the compression rate of v^n comes back with
+         the opposite sign every step, undamped, and noise feeds it; at 0.47 they are -0.75 and
+         -0.08. Measured on the layered column of tests/test_layers.c (20 across, particle
+         density, sph_advance, over the second second): beta = 1/2 3.9 % of sqrt(g H) and 5.7 %
+         time-averaged pressure error, the region-averaged pressure at frame ends off by up to
+         33 % (interior rows) and 107 % (bottom row) of the bottom pressure; beta = 0.47 0.49 %
+         and 0.63 % (with the gradient's lattice normalisation, pg_norm). Smaller beta damps more
+         in the model (0 gives 0.71, 0.4 gives 0.41) but not in a fluid: tests/test_reliability.c's
+         periodic box of random velocities gained kinetic energy without forcing (SPH_ERR_UNSTABLE)
+         at beta <= 0.46, more checks failing the smaller beta. The dam break of
+         tests/test_pcisph.c at sph_stable_dt without retries depends on any change of the
+         numerics: a particle in a corner compresses without bound at beta = 0.48 and 0.5 (with
+         pg_norm), not at 0.40-0.47 or 0.49. */
+
+#define SPH__PCI_BETA 0.47 /* weight of v^n in enhanced PCISPH's Verlet prediction, see (d) */
 
 /* sum_j |grad W(x_j)|^2 over a square lattice of spacing dx (the prototype's neighbourhood). */
 static double sph__lattice_grad2(const sph_kernel* k, sph_real dx) {
@@ -6572,9 +6665,11 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
     const int per_particle = w->def.pcisph_factor == SPH_PCISPH_PER_PARTICLE;
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK, nD = w->n * (size_t)D;
     const sph_real drift = verlet ? SPH__R(0.5) * dt : dt;
-    /* with Verlet the predicted density sees half of a velocity change (midpoint rule, or a half
-       drift for summation), so the gain doubles */
-    const double S = (summation ? (double)w->priv.lattice_sum : 1.0) * (verlet ? 2.0 : 1.0);
+    /* with Verlet the predicted density sees a fraction of a velocity change: half with
+       summation (a half drift), 1 - SPH__PCI_BETA with continuity (see (d) above); the gain
+       grows by its inverse */
+    const double S = (summation ? (double)w->priv.lattice_sum : 1.0) *
+                     (verlet ? (summation ? 2.0 : 1.0 / (1.0 - SPH__PCI_BETA)) : 1.0);
     double t0 = sph__now(), tstart = t0, err = 0, errmax = 0, proto[SPH_MAX_PHASES];
     sph_real keep;
     double errmax_min = 0;
@@ -6625,13 +6720,14 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
     if (w->nb > 0) sph__stage_wall(w, &c, SPH__WALL_STATE);
     if (c.laminar || c.av) sph__stage_interact(w, &c, SPH__VISCOUS, w->a);
     sph__time(w, SPH_STAGE_FORCES, &t0);
-    /* gains */
+    /* gains (the gradient's lattice normalisation pg_norm moves a particle that much further per
+       pascal, so the gain is divided by it) */
     if (!(w->stats.gain_factor > 0) || w->stats.gain_factor > 1) w->stats.gain_factor = 1;
     {
         const double g2 = sph__lattice_grad2(&w->kernel, w->dx);
         for (q = 0; q < w->nphase; ++q) {
             const double m = (double)w->phases[q].mass, r0 = (double)w->phases[q].rest_density;
-            proto[q] = (double)w->def.pcisph_gain * w->stats.gain_factor * S * r0 * r0 /
+            proto[q] = (double)w->def.pcisph_gain * w->stats.gain_factor * S / (double)c.pg_norm * r0 * r0 /
                        (2 * (double)dt * (double)dt * m * m * g2);
         }
     }
@@ -6642,7 +6738,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
             const sph_real den = D == 2   ? sph__pcisph_denominator(&c, (size_t)i, 2)
                                  : D == 3 ? sph__pcisph_denominator(&c, (size_t)i, 3)
                                           : sph__pcisph_denominator(&c, (size_t)i, 1);
-            f = den > 0 ? (sph_real)((double)w->def.pcisph_gain * w->stats.gain_factor * S * (double)w->rho[i] /
+            f = den > 0 ? (sph_real)((double)w->def.pcisph_gain * w->stats.gain_factor * S / (double)c.pg_norm * (double)w->rho[i] /
                                      (2 * (double)dt * (double)dt * (double)den))
                         : 0;
         } else {
@@ -6701,7 +6797,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
         for (i = 0; i < (sph__idx)nD; ++i) {
             const sph_real vs = w->v[i] + dt * (w->a[i] + w->priv.ap[i]);
             w->priv.xp[i] = w->x[i] + drift * vs;
-            w->priv.vp[i] = verlet ? SPH__R(0.5) * (w->v[i] + vs) : vs;
+            w->priv.vp[i] = verlet ? SPH__R(SPH__PCI_BETA) * w->v[i] + SPH__R(1 - SPH__PCI_BETA) * vs : vs;
         }
         if (summation) {
             sph__ctx cp = c;
