@@ -434,8 +434,9 @@ int main(void) {
    (without it 2.7 % too steep in every layer). Measured (tests/test_layers.c: 1000/500/100
    kg/m^3, 0.2 m each, 0.6 m wide, 20 across, sph_set_hydrostatic then sph_advance; largest speed
    over the last second against sqrt(g H), layer- and time-averaged pressure against the layered
-   profile p(0)): enhanced PCISPH after 2 s 0.49 % and 0.63 % (float 1.08 % and 0.68 %: its motion
-   after the first second depends on round-off), WCSPH after 0.5 s multiphase 0.96 %
+   profile p(0)): enhanced PCISPH after 2 s 0.49 % and 1.2 % (float 1.08 % and 0.68 %: its motion
+   after the first second depends on round-off; the pressure was 0.63 % before sph_advance split
+   a frame's end into equal steps: where the steps land moves it), WCSPH after 0.5 s multiphase 0.96 %
    and 0.73 %, interface 0.50 % and 0.26 %; no particle past its layer's interface. After 10 s
    at 30 across (over the last second): WCSPH multiphase 0.34 % and 0.92 % (spread 0.12 dx),
    interface with continuity 0.25 % and 0.57 %, with particle density 4.7 % and 0.51 %, enhanced
@@ -5760,16 +5761,17 @@ static void sph__record_nonpressure(sph_world* w) {
     w->stats.a_np_max = sqrt(m);
 }
 
-/* The warm start of the pressure solves: def.warm_start times the last pressure, except from the
-   second retry in a row of a step sph_advance is retrying. The pressure of the failed step's start
-   can be part of what failed: a corner particle whose walls extrapolate its own pressure can carry
-   a pressure that, half of it warm-started, blows the retry up at any dt (enhanced PCISPH's dam
-   break failed 13 retries down to dt = 4e-9 s); such a retry starts from p = 0. The first retry
-   keeps the warm start: from p = 0 a solve meets the mean-compression tolerance long before it
-   has rebuilt the hydrostatic pressure (a uniform sag compresses only the bottom rows), so the
-   column fell for a step at every retry. IISPH's 2D tank at rest (1 x 0.8 m, dx 0.02, 0.05 s
-   frames) retried about once a frame, and with cold first retries its speed late in 3 s stayed
-   near 0.1 sqrt(g H). */
+/* The warm start of the pressure solves: def.warm_start times the last pressure, except in a step
+   sph_advance is retrying: from its first retry with extrapolated wall pressure, from its second
+   with the others. The pressure of the failed step's start can be part of what failed: a corner
+   particle whose walls extrapolate its own pressure can carry a pressure that, half of it
+   warm-started, blows the retry up at any dt (enhanced PCISPH's dam break failed 13 retries down
+   to dt = 4e-9 s, its 2D jet of tests/test_scenes.c 12 retries down to 5e-7 s); such a retry
+   starts from p = 0. Otherwise the first retry keeps the warm start: from p = 0 a solve meets the
+   mean-compression tolerance long before it has rebuilt the hydrostatic pressure (a uniform sag
+   compresses only the bottom rows), so the column fell for a step at every retry. IISPH's 2D tank
+   at rest (zero wall pressure, 1 x 0.8 m, dx 0.02, 0.05 s frames) retried about once a frame, and
+   with cold first retries its speed late in 3 s stayed near 0.1 sqrt(g H). */
 static sph_real sph__warm(const sph_world* w) { return w->priv.cold_start ? 0 : w->def.warm_start; }
 
 /* The end of an iterative solve above its tolerance: the step was taken with the last pressure,
@@ -8512,7 +8514,7 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
         w->priv.correct_fraction = fmin(1.0, w->stats.dt_factor);
         if (w->priv.dt_unpressed > 4 * dt_stable)
             w->priv.correct_fraction *= 4 * dt_stable / w->priv.dt_unpressed;
-        w->priv.cold_start = in_row > 1;
+        w->priv.cold_start = in_row > (w->def.boundary_pressure == SPH_BP_EXTRAPOLATE ? 0 : 1);
         s = sph_step(w, (sph_real)dt);
         iterations += w->stats.iterations;
         w->priv.correct_fraction = 1;
