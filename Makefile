@@ -39,6 +39,7 @@ TEST_SRC = tests/main.c tests/impl.c tests/test_kernels.c tests/test_grid.c test
            tests/test_compressible.c tests/test_soc.c tests/test_io.c tests/test_save.c \
            tests/test_reliability.c tests/test_oom.c tests/test_validation.c tests/test_scenes.c \
            tests/test_hostile.c tests/test_viscous.c tests/test_layers.c tests/test_rt.c \
+           tests/test_verlet.c \
            tests/test_compile.c \
            tests/compile_second.c \
            tests/compile_static.c

@@ -104,6 +104,21 @@ int main(void) {
    through a hash table, so one particle far away costs no memory. Periodic directions wrap.
    sph_neighbors stores compressed lists (begin/count/idx) filled in parallel chunks; memory is
    reused between builds and grows only when a chunk needs more room.
+   A world keeps its lists between steps with a skin (Verlet lists: Verlet 1967; Allen &
+   Tildesley 1987 sec. 5.3): with def.neighbor_skin = s > 0 the particles are sorted into cells
+   of (1 + s) R and candidate lists within (1 + s) R are searched; each step keeps of them the
+   pairs within R (so every pair loop sees exactly the pairs a search would give, in another
+   order), and they are searched again once any fluid or boundary particle has moved s R / 2
+   since (by the flow, a motion callback or the host writing w.x), or when particles were
+   added, the walls changed, sph_advance rolled a step back or s changed. w.stats.
+   neighbor_builds counts the searches. The default (-1) takes s = 0.2 for WCSPH and the
+   compressible step and searches every step (s = 0) for PCISPH, IISPH, DFSPH and PBF, whose
+   steps move particles up to 0.4 dx: a skin would be searched again almost every step.
+   Measured (whole process, 1 thread, medians of 5 alternating pairs; README, "Speed"): the 2D
+   WCSPH dam break takes 0.77-0.82 of the time without a skin, the 3D one 0.84-0.88; DFSPH,
+   IISPH and PBF with s = 0.2 1.05-1.10. The candidate lists add about a third to the bytes
+   per particle. A saved world keeps the positions of its last search, so a restart continues
+   bit for bit.
 
    THE WORLD
    sph_world_def_default(dim) gives physical defaults; change fields, then sph_world_init, which
@@ -368,8 +383,9 @@ int main(void) {
    step allocates nothing in the steady state. Optional arrays (per-particle mass, Verlet
    scratch) exist only when used. WCSPH with continuity density, IISPH and DFSPH keep the kernel
    gradient of every listed pair for the step's later passes (8 bytes a pair in double: the 2D
-   WCSPH dam break takes 483 bytes per fluid particle, 283 without). sph_world_free releases
-   everything the world allocated.
+   WCSPH dam break takes 483 bytes per fluid particle, 283 without). The candidate lists of
+   def.neighbor_skin (on by default for WCSPH) add about a third: the same scene at 10k
+   particles 518 -> 714 bytes. sph_world_free releases everything the world allocated.
 
    ERRORS
    Functions that can fail return sph_status; w.error holds a message with the detail (field,
@@ -1076,6 +1092,14 @@ typedef struct sph_world_def {
     int max_substeps;          /* sph_advance: at most this many sub-steps (retries included) per
                                   call, else SPH_ERR_BUDGET with the world as before the call;
                                   default 100000; [1, 2^30]                                      */
+    sph_real neighbor_skin;    /* Verlet skin of the neighbour lists, a fraction of the kernel's
+                                  support radius R [-]: candidate lists within (1 + skin) R are
+                                  searched (and the particles sorted by cell) only when a particle
+                                  has moved half the skin since, and each step keeps of them the
+                                  pairs within R (Verlet 1967; see NEIGHBOUR GRID). 0 = search
+                                  every step; default -1: automatic, 0.2 for WCSPH and the
+                                  compressible step, 0 for PCISPH, IISPH, DFSPH and PBF; -1 or
+                                  [0, 1]                                                         */
     sph_force_fn force;        /* optional external accelerations (sph_force_fn); default NULL  */
     void* force_user;          /* passed to force as user                                        */
     sph_boundary_fn boundary_motion; /* optional moving boundary particles (default NULL)        */
@@ -1155,12 +1179,26 @@ typedef struct sph_stats {
                                  kinetic energy since the forcing stopped [J] (the energy check,
                                  sph__energy_check)                                              */
     long unforced_steps;      /* steps since then (0: forced, or none yet)                       */
+    uint64_t neighbor_builds; /* neighbour searches (sort by cell and list build) since
+                                 sph_world_init, in the steps kept (sph_advance undoes a
+                                 rolled-back step's with it): one a step with neighbor_skin 0,
+                                 fewer with a skin (w.steps / neighbor_builds steps per search) */
 } sph_stats;
 
 /* Private state (do not touch). */
 typedef struct sph__private {
     sph_grid grid, bgrid;           /* fluid and boundary grids (same cells)                       */
     sph_neighbors ff, fb, bf, bb;   /* fluid->fluid, fluid->boundary, boundary->fluid, ->boundary  */
+    sph_neighbors cff, cfb, cbf;    /* def.neighbor_skin > 0: the candidate lists within (1 + skin)
+                                       R that ff, fb and bf are filtered from every step        */
+    sph_real *vl_x, *vl_bx;         /* positions of fluid and boundary particles at their build    */
+    size_t vl_x_cap, vl_bx_cap;     /* reals                                                      */
+    int vl_valid;                   /* the candidate lists hold for the current particle order     */
+    size_t vl_n, vl_nb;             /* particle counts at the build                               */
+    uint64_t vl_sorts;              /* w->priv.sorts at the build                                 */
+    int vl_restore;                 /* loaded: vl_x, vl_bx, vl_radius, vl_n/nb hold a saved build
+                                       to search again at the next step (sph__verlet_restore)      */
+    sph_real vl_radius;             /* their radius [m]                                           */
     uint8_t* perm_buf;              /* permutation scratch, capacity * largest element              */
     size_t perm_cap;                /* bytes                                                        */
     double* block;                  /* per-block partial reductions                                 */
@@ -1227,8 +1265,9 @@ typedef struct sph__private {
 } sph__private;
 
 /* The world: a caller-owned plain struct. Read the arrays directly; positions and velocities may
-   be written between steps. Particles are reordered by cell at every step (the second-order
-   scheme: whenever it rebuilds its lists): follow a particle by its id, not by its index. Array
+   be written between steps. Particles are reordered by cell at every neighbour search (every
+   step, or with def.neighbor_skin when the lists are searched again; the second-order scheme:
+   whenever it rebuilds its lists): follow a particle by its id, not by its index. Array
    pointers change only when particles are added (w.e appears when a gas phase is added). Use one
    world from one thread at a time (see THREAD SAFETY at the top). */
 typedef struct sph_world {
@@ -2546,6 +2585,131 @@ SPHDEF sph_status sph_neighbors_build(sph_neighbors* nl, const sph_grid* g, cons
     }
 }
 
+/* r^2 of a candidate pair as the search computes it: d = p - x_j (periodic directions wrapped
+   as in SPH__GRID_VISIT, pw = p wrapped), r^2 = (dx^2 + dy^2) + dz^2. */
+SPH__INLINE sph_real sph__filter_r2(const sph_grid* g, const sph_real* p, const sph_real* pw,
+                                    const sph_real* xj, int per, const int D) {
+    sph_real r2 = 0, dd;
+    int k;
+    if (!per) {
+        dd = p[0] - xj[0]; r2 += dd * dd;
+        if (D > 1) { dd = p[1] - xj[1]; r2 += dd * dd; }
+        if (D > 2) { dd = p[2] - xj[2]; r2 += dd * dd; }
+        return r2;
+    }
+    for (k = 0; k < D; ++k) {
+        dd = g->periodic[k] ? sph__wrap_delta(pw[k] - sph__periodic_wrap(g, k, xj[k]), g->len[k])
+                            : p[k] - xj[k];
+        r2 += dd * dd;
+    }
+    return r2;
+}
+
+/* Verlet lists (Verlet 1967): the pairs of candidate lists `cand` (built on grid g, points x,
+   queries xq, with a radius beyond `radius`) that lie within radius, into nl, in the candidates'
+   order, for the queries of chunk c. The test is the search's own (sph__filter_r2, r^2 <
+   radius^2), so nl holds exactly the pairs a search with radius would find
+   (tests/test_verlet.c). nl's chunk regions are its own, sized from the last filter as the
+   search sizes them (not the candidates': the per-pair caches follow the lists' room); a query
+   whose candidates all fit is written branch-free, as in the search. Returns the entries the
+   chunk needed. */
+SPH__INLINE size_t sph__neighbors_filter_chunk(sph_neighbors* nl, const sph_neighbors* cand,
+                                               const sph_grid* g, const sph_real* x,
+                                               const sph_real* xq, sph_real r2max, size_t c,
+                                               const int D) {
+    size_t i, i0 = c * SPH__CHUNK, i1 = i0 + SPH__CHUNK;
+    size_t pos = nl->chunk_off[c], end = pos + nl->chunk_cap[c];
+    const int per = g->periodic[0] || g->periodic[1] || g->periodic[2];
+    if (i1 > cand->n) i1 = cand->n;
+    for (i = i0; i < i1; ++i) {
+        const sph_real* p = xq + i * (size_t)D;
+        const size_t k0 = cand->begin[i], k1 = k0 + cand->count[i], b0 = pos;
+        sph_real pw[3] = {0, 0, 0};
+        size_t kk;
+        int k;
+        if (per)
+            for (k = 0; k < D; ++k) pw[k] = g->periodic[k] ? sph__periodic_wrap(g, k, p[k]) : p[k];
+        if (pos <= end && end - pos >= k1 - k0) {
+            for (kk = k0; kk < k1; ++kk) {
+                const uint32_t j = cand->idx[kk];
+                const sph_real r2 = sph__filter_r2(g, p, pw, x + (size_t)j * (size_t)D, per, D);
+                nl->idx[pos] = j;
+                pos += (size_t)(r2 < r2max);
+            }
+        } else { /* near the region's end: counts what is missing */
+            for (kk = k0; kk < k1; ++kk) {
+                const uint32_t j = cand->idx[kk];
+                if (sph__filter_r2(g, p, pw, x + (size_t)j * (size_t)D, per, D) < r2max) {
+                    if (pos < end) nl->idx[pos] = j;
+                    ++pos;
+                }
+            }
+        }
+        nl->begin[i] = b0;
+        nl->count[i] = (uint32_t)(pos - b0);
+    }
+    return pos - nl->chunk_off[c];
+}
+
+/* Lays nl out like sph__neighbors_build (chunk regions from the last filter's needs, a second
+   pass when one overflowed) and filters cand into it. Grows memory only when the lists grew. */
+static sph_status sph__neighbors_filter(sph_neighbors* nl, const sph_neighbors* cand,
+                                        const sph_grid* g, const sph_real* x, const sph_real* xq,
+                                        sph_real radius) {
+    const sph_real r2max = radius * radius;
+    const size_t nchunk = cand->nchunk, nq = cand->n;
+    size_t c, total_cap;
+    int pass;
+    if (nq > nl->cap_n) {
+        size_t cap = nq + nq / 4 + 16;
+        if (!sph__grow((void**)&nl->begin, cap, sizeof(size_t)) ||
+            !sph__grow((void**)&nl->count, cap, sizeof(uint32_t)))
+            return sph__neighbors_nomem(nl);
+        nl->cap_n = cap;
+    }
+    if (nchunk > nl->cap_chunk) {
+        size_t cap = nchunk + nchunk / 4 + 4;
+        if (!sph__grow((void**)&nl->chunk_off, cap + 1, sizeof(size_t)) ||
+            !sph__grow((void**)&nl->chunk_need, cap, sizeof(size_t)))
+            return sph__neighbors_nomem(nl);
+        if (!sph__grow((void**)&nl->chunk_cap, cap, sizeof(size_t))) return sph__neighbors_nomem(nl);
+        for (c = nl->cap_chunk; c < cap; ++c) nl->chunk_cap[c] = 0;
+        nl->cap_chunk = cap;
+    }
+    nl->n = nq;
+    nl->nchunk = nchunk;
+    for (pass = 0; pass < 2; ++pass) {
+        sph__idx ci;
+        int overflow = 0;
+        total_cap = 0;
+        for (c = 0; c < nchunk; ++c) { nl->chunk_off[c] = total_cap; total_cap += nl->chunk_cap[c]; }
+        if (total_cap > nl->cap_idx) {
+            if (!sph__grow((void**)&nl->idx, total_cap, sizeof(uint32_t)))
+                return sph__neighbors_nomem(nl);
+            nl->cap_idx = total_cap;
+        }
+        SPH__OMP_FOR_DYNAMIC(nchunk)
+        for (ci = 0; ci < (sph__idx)nchunk; ++ci) {
+            size_t need;
+            if (g->dim == 2) need = sph__neighbors_filter_chunk(nl, cand, g, x, xq, r2max, (size_t)ci, 2);
+            else if (g->dim == 3) need = sph__neighbors_filter_chunk(nl, cand, g, x, xq, r2max, (size_t)ci, 3);
+            else need = sph__neighbors_filter_chunk(nl, cand, g, x, xq, r2max, (size_t)ci, 1);
+            nl->chunk_need[ci] = need;
+        }
+        for (c = 0; c < nchunk; ++c) {
+            if (nl->chunk_need[c] > nl->chunk_cap[c]) {
+                overflow = 1;
+                nl->chunk_cap[c] = nl->chunk_need[c] + nl->chunk_need[c] / 4 + 16;
+            }
+        }
+        if (!overflow) break;
+        SPH_ASSERT(pass == 0); /* the second pass has room for every chunk */
+    }
+    nl->total = 0;
+    for (c = 0; c < nchunk; ++c) nl->total += nl->chunk_need[c];
+    return SPH_OK;
+}
+
 SPHDEF void sph_neighbors_free(sph_neighbors* nl) {
     if (!nl) return;
     SPH_FREE(nl->begin);
@@ -2780,6 +2944,7 @@ SPHDEF sph_world_def sph_world_def_default(int dim) {
        keeps its centre on the fluid side of the wall's face (sph__wall_contact) */
     d.wall_contact = (sph_real)(0.02 + 0.5 * sqrt((double)(dim >= 1 && dim <= 3 ? dim : 3)));
     d.max_substeps = 100000;
+    d.neighbor_skin = -1; /* automatic: see sph__verlet_radius */
     d.boundary_pressure = SPH_BP_AUTO;
     d.boundary_volume = SPH_BVOL_GIVEN;
     d.boundary_gamma = 0; /* calibrated by sph_world_init (sph__akinci_gamma) */
@@ -3001,6 +3166,10 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
                (double)d->max_displacement);
     SPH__CHECK(d->max_substeps >= 1 && d->max_substeps <= (1 << 30),
                "sph_world_def.max_substeps = %d: must be in [1, 2^30]", d->max_substeps);
+    SPH__CHECK(d->neighbor_skin == -1 || (d->neighbor_skin >= 0 && d->neighbor_skin <= 1),
+               "sph_world_def.neighbor_skin = %g: must be -1 (automatic) or in [0, 1] (support "
+               "radii)",
+               (double)d->neighbor_skin);
     for (k = 0; k < d->dim; ++k) {
         SPH__CHECK(sph__finite((double)d->domain_lo[k]) && sph__finite((double)d->domain_hi[k]) &&
                        d->domain_lo[k] <= d->domain_hi[k],
@@ -3196,6 +3365,11 @@ SPHDEF void sph_world_free(sph_world* w) {
     sph_neighbors_free(&w->priv.fb);
     sph_neighbors_free(&w->priv.bf);
     sph_neighbors_free(&w->priv.bb);
+    sph_neighbors_free(&w->priv.cff);
+    sph_neighbors_free(&w->priv.cfb);
+    sph_neighbors_free(&w->priv.cbf);
+    SPH_FREE(w->priv.vl_x);
+    SPH_FREE(w->priv.vl_bx);
     SPH_FREE(w->priv.perm_buf);
     SPH_FREE(w->priv.block);
     SPH_FREE(w->priv.rho_n);
@@ -3811,7 +3985,9 @@ SPHDEF size_t sph_world_memory(const sph_world* w) {
              sph__grid_memory(&w->priv.sgrid);
     bytes += sph__neighbors_memory(&w->priv.ff) + sph__neighbors_memory(&w->priv.fb) +
              sph__neighbors_memory(&w->priv.bf) + sph__neighbors_memory(&w->priv.bb) +
-             sph__neighbors_memory(&w->priv.snl);
+             sph__neighbors_memory(&w->priv.snl) + sph__neighbors_memory(&w->priv.cff) +
+             sph__neighbors_memory(&w->priv.cfb) + sph__neighbors_memory(&w->priv.cbf) +
+             (w->priv.vl_x_cap + w->priv.vl_bx_cap) * sizeof(sph_real);
     bytes += w->priv.perm_cap + w->priv.block_cap * sizeof(double) +
              (w->priv.rho_n_cap + w->priv.aii_cap + w->priv.src_cap + w->priv.ap_cap + w->priv.cg_cap +
               w->priv.df_alpha_cap + w->priv.df_alpha_v_cap + w->priv.df_vs_cap +
@@ -4367,12 +4543,18 @@ static size_t sph__count_within(const sph_grid* g, const sph_real* p, const sph_
    lattice sum, so a full lattice of wall particles keeps V_b = dx^dim), so sparse or single-layer
    walls weigh as much as a full lattice and dense clusters do not count twice. Recomputed
    whenever the walls are re-sorted (every step when they move). */
-static sph_status sph__stage_boundary_volume(sph_world* w) {
+static sph_status sph__stage_boundary_volume(sph_world* w, sph_real radius, int search) {
     const int D = w->dim;
-    const sph_real R = w->kernel.radius, w0 = sph__kw(w->kernel.form, 0);
+    const sph_real w0 = sph__kw(w->kernel.form, 0);
     sph__idx b;
-    sph_status s = sph__neighbors_build(&w->priv.bb, &w->priv.bgrid, w->b_x, NULL, w->b_x, w->nb, R, 1);
-    if (s != SPH_OK) return sph__fail(w, s, -1, "boundary neighbour lists: %s", sph_status_string(s));
+    /* radius: the kernel's support, or def.neighbor_skin's candidate radius, whose lists serve
+       the steps that reuse them (the kernel is exactly 0 from its support on) */
+    if (search) {
+        sph_status s = sph__neighbors_build(&w->priv.bb, &w->priv.bgrid, w->b_x, NULL, w->b_x,
+                                            w->nb, radius, 1);
+        if (s != SPH_OK)
+            return sph__fail(w, s, -1, "boundary neighbour lists: %s", sph_status_string(s));
+    }
     SPH__OMP_FOR(w->nb)
     for (b = 0; b < (sph__idx)w->nb; ++b) {
         const sph_neighbors* nl = &w->priv.bb;
@@ -4391,13 +4573,119 @@ static sph_status sph__stage_boundary_volume(sph_world* w) {
     return SPH_OK;
 }
 
-/* Neighbours stage: sort fluid (and moving boundary) particles by cell, then build the lists
-   fluid->fluid, fluid->boundary and boundary->fluid once for the whole step. */
-static sph_status sph__stage_neighbors(sph_world* w) {
+/* A grid's cells made `cell` wide, its arrays kept (the periodic box from w.def, as at
+   sph_world_init). The cell must leave two cells along a periodic direction. */
+static void sph__grid_recell(sph_world* w, sph_grid* g, sph_real cell) {
+    const sph_grid keep = *g;
+    int per[3];
+    sph_status s;
+    per[0] = keep.periodic[0];
+    per[1] = keep.periodic[1];
+    per[2] = keep.periodic[2];
+    s = sph_grid_init(g, keep.dim, cell, per, w->def.domain_lo, w->def.domain_hi);
+    SPH_ASSERT(s == SPH_OK);
+    (void)s;
+    g->order = keep.order;
+    g->start = keep.start;
+    g->key = keep.key;
+    g->bucket = keep.bucket;
+    g->cap_n = keep.cap_n;
+    g->cap_bucket = keep.cap_bucket;
+}
+
+/* def.neighbor_skin = -1 (the default): the skin of the explicit steps (WCSPH, compressible),
+   whose acoustic step moves a particle a few hundredths of R, so that lists within 1.2 R serve
+   10-40 steps; none for PCISPH, IISPH, DFSPH and PBF, whose steps move particles up to
+   cfl_velocity = 0.4 dx: a skin would be searched again almost every step, at a larger radius
+   (their time to solution 5-10 % longer with a skin of 0.2 R: 2D dam break at 10k particles,
+   3D at 6859). 0.1, 0.15 and 0.2 gave WCSPH the same time within the noise (2D dam break to
+   t = 0.6 s: 0.785, 0.773 and 0.771 of the time without a skin; 3D to 0.12 s: 0.85 and 0.84). */
+#define SPH__SKIN_AUTO SPH__R(0.2)
+
+/* The reach of the candidate lists of a step of `solver` [m]: (1 + skin) R, at most half a
+   periodic direction's length (the grid needs two cells there); R: no skin. */
+static sph_real sph__verlet_radius_for(const sph_world* w, int solver) {
+    const sph_real R = w->kernel.radius;
+    const sph_real skin = w->def.neighbor_skin >= 0 ? w->def.neighbor_skin
+                          : (solver == SPH_SOLVER_WCSPH || solver == SPH_SOLVER_COMPRESSIBLE)
+                              ? SPH__SKIN_AUTO
+                              : 0;
+    sph_real r = R * (1 + skin);
+    int k;
+    for (k = 0; k < w->dim; ++k)
+        if (w->priv.grid.periodic[k] && r > SPH__R(0.5) * w->priv.grid.len[k])
+            r = SPH__R(0.5) * w->priv.grid.len[k];
+    return r > R ? r : R;
+}
+
+static sph_real sph__verlet_radius(const sph_world* w) {
+    return sph__verlet_radius_for(w, w->priv.solver);
+}
+
+/* The largest squared distance of a point of x from its place in x0 [m^2] (minimum image along
+   periodic directions; a non-finite point counts as far). max does not depend on the order it
+   is taken in, so the parallel pass gives the serial result. */
+static sph_real sph__max_shift2(const sph_grid* g, const sph_real* x, const sph_real* x0, size_t n) {
+    const int D = g->dim, per = g->periodic[0] || g->periodic[1] || g->periodic[2];
+    sph_real m = 0;
+    sph__idx i;
+    if (!per) { /* the common case, inline: no minimum image (3D, 60k wall particles: 1.6 % of
+                   a WCSPH step through sph_grid_delta) */
+        sph_real m2 = 0;
+#if defined(_OPENMP) && _OPENMP >= 201107
+#pragma omp parallel for schedule(static) if (n > 4096) reduction(max : m2)
+#endif
+        for (i = 0; i < (sph__idx)n; ++i) {
+            const sph_real* a = x + (size_t)i * (size_t)D;
+            const sph_real* b = x0 + (size_t)i * (size_t)D;
+            sph_real r2 = (a[0] - b[0]) * (a[0] - b[0]);
+            if (D > 1) r2 += (a[1] - b[1]) * (a[1] - b[1]);
+            if (D > 2) r2 += (a[2] - b[2]) * (a[2] - b[2]);
+            if (!(r2 <= SPH__R(1e30))) r2 = SPH__R(1e30);
+            if (r2 > m2) m2 = r2;
+        }
+        return m2;
+    }
+#if defined(_OPENMP) && _OPENMP >= 201107
+#pragma omp parallel for schedule(static) if (n > 4096) reduction(max : m)
+#endif
+    for (i = 0; i < (sph__idx)n; ++i) {
+        sph_real d[3] = {0, 0, 0}, r2 = 0;
+        int k;
+        sph_grid_delta(g, x + (size_t)i * (size_t)D, x0 + (size_t)i * (size_t)D, d);
+        for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+        if (!(r2 <= SPH__R(1e30))) r2 = SPH__R(1e30);
+        if (r2 > m) m = r2;
+    }
+    return m;
+}
+
+/* def.neighbor_skin's search: the particles sorted by cell (cells of the candidate radius rs),
+   candidate lists within rs, and the positions they were built at. */
+static sph_status sph__verlet_build(sph_world* w, sph_real rs) {
+    const size_t D = (size_t)w->dim;
     sph__array arr[16];
     sph_status s;
-    const sph_real R = w->kernel.radius;
     int narr;
+    w->priv.vl_valid = 0;
+    /* the build positions' room first: out of memory here changes nothing */
+    if (w->n * D > w->priv.vl_x_cap) {
+        const size_t cap = w->capacity * D;
+        if (!sph__grow((void**)&w->priv.vl_x, cap, sizeof(sph_real)))
+            return sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory (neighbour lists)");
+        w->priv.vl_x_cap = cap;
+    }
+    if (w->nb * D > w->priv.vl_bx_cap) {
+        const size_t cap = w->b_capacity * D;
+        if (!sph__grow((void**)&w->priv.vl_bx, cap, sizeof(sph_real)))
+            return sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory (neighbour lists)");
+        w->priv.vl_bx_cap = cap;
+    }
+    if (w->priv.grid.cell != rs) sph__grid_recell(w, &w->priv.grid, rs);
+    if (w->priv.bgrid.cell != rs) { /* the walls are sorted again into the new cells */
+        sph__grid_recell(w, &w->priv.bgrid, rs);
+        w->priv.b_dirty = 1;
+    }
     s = sph_grid_build(&w->priv.grid, w->x, w->n);
     if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour grid: %s", sph_status_string(s));
     narr = sph__fluid_arrays(w, arr);
@@ -4409,7 +4697,144 @@ static sph_status sph__stage_neighbors(sph_world* w) {
         narr = sph__boundary_arrays(w, arr);
         sph__permute(w, arr, narr, w->priv.bgrid.order, w->nb);
         if (w->def.boundary_volume == SPH_BVOL_AKINCI) {
-            s = sph__stage_boundary_volume(w);
+            s = sph__stage_boundary_volume(w, rs, 1);
+            if (s != SPH_OK) return s;
+        }
+        w->priv.b_dirty = 0;
+    }
+    s = sph__neighbors_build(&w->priv.cff, &w->priv.grid, w->x, NULL, w->x, w->n, rs, 1);
+    if (s == SPH_OK && w->nb > 0) {
+        s = sph__neighbors_build(&w->priv.cfb, &w->priv.bgrid, w->b_x, NULL, w->x, w->n, rs, 0);
+        if (s == SPH_OK)
+            s = sph__neighbors_build(&w->priv.cbf, &w->priv.grid, w->x, NULL, w->b_x, w->nb, rs, 0);
+    }
+    if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour lists: %s", sph_status_string(s));
+    sph__copy(w->priv.vl_x, w->x, w->n * D * sizeof(sph_real));
+    sph__copy(w->priv.vl_bx, w->b_x, w->nb * D * sizeof(sph_real));
+    w->priv.vl_valid = 1;
+    w->priv.vl_n = w->n;
+    w->priv.vl_nb = w->nb;
+    w->priv.vl_sorts = w->priv.sorts;
+    w->priv.vl_radius = rs;
+    ++w->stats.neighbor_builds;
+    return SPH_OK;
+}
+
+/* A loaded world's candidate lists (sph_world_load, sph_world_copy): searched again at the
+   positions of their build, which the file keeps, without sorting; the particles are still in
+   the order of that build, so the lists come out as they were and the run continues bit for
+   bit. Particles no longer in that order (a host's change) get a new search instead. */
+static sph_status sph__verlet_restore(sph_world* w, sph_real rs) {
+    const size_t n = w->n, nb = w->nb;
+    sph_real* vx = w->priv.vl_x;
+    sph_real* vbx = w->priv.vl_bx;
+    sph_status s;
+    size_t i;
+    int in_order = 1;
+    if (w->priv.grid.cell != rs) sph__grid_recell(w, &w->priv.grid, rs);
+    if (w->priv.bgrid.cell != rs) sph__grid_recell(w, &w->priv.bgrid, rs);
+    s = sph_grid_build(&w->priv.grid, vx, n);
+    if (s == SPH_OK && nb > 0) s = sph_grid_build(&w->priv.bgrid, vbx, nb);
+    if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour grid: %s", sph_status_string(s));
+    for (i = 0; i < n && in_order; ++i) in_order = w->priv.grid.order[i] == (uint32_t)i;
+    for (i = 0; i < nb && in_order; ++i) in_order = w->priv.bgrid.order[i] == (uint32_t)i;
+    if (!in_order) {
+        w->priv.vl_restore = 0;
+        w->priv.b_dirty = nb > 0;
+        return sph__verlet_build(w, rs);
+    }
+    if (nb > 0 && w->def.boundary_motion && w->def.boundary_volume == SPH_BVOL_AKINCI)
+        s = sph__neighbors_build(&w->priv.bb, &w->priv.bgrid, vbx, NULL, vbx, nb, rs, 1);
+    if (s == SPH_OK) s = sph__neighbors_build(&w->priv.cff, &w->priv.grid, vx, NULL, vx, n, rs, 1);
+    if (s == SPH_OK && nb > 0) {
+        s = sph__neighbors_build(&w->priv.cfb, &w->priv.bgrid, vbx, NULL, vx, n, rs, 0);
+        if (s == SPH_OK)
+            s = sph__neighbors_build(&w->priv.cbf, &w->priv.grid, vx, NULL, vbx, nb, rs, 0);
+    }
+    if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour lists: %s", sph_status_string(s));
+    w->priv.b_dirty = 0;
+    w->priv.vl_valid = 1;
+    w->priv.vl_sorts = w->priv.sorts;
+    w->priv.vl_restore = 0;
+    return SPH_OK;
+}
+
+/* Verlet lists (Verlet 1967; Allen & Tildesley 1987 sec. 5.3): candidate lists within
+   rs = R + s hold every pair within R while no particle has moved s/2 since their build (two
+   particles then came at most s closer). They are searched again when one has (fluid or
+   boundary, by the motion callback or the host), when particles were added or reordered
+   (sph_advance's rollback, the second-order scheme, a load), when the walls changed or the
+   skin did; else each step keeps of them the pairs within R, in ff, fb and bf, which are then
+   exactly the lists a search would give (in another order: the particles are sorted by cell
+   only at a search), so every pair loop sees the same pairs either way. */
+static sph_status sph__stage_neighbors_skin(sph_world* w, sph_real rs) {
+    const sph_real R = w->kernel.radius, half = SPH__R(0.5) * (rs - R);
+    sph_status s;
+    int reuse;
+    if (w->priv.vl_restore) {
+        if (w->priv.vl_radius == rs && w->priv.vl_n == w->n && w->priv.vl_nb == w->nb) {
+            s = sph__verlet_restore(w, rs);
+            if (s != SPH_OK) return s;
+        }
+        w->priv.vl_restore = 0;
+    }
+    reuse = w->priv.vl_valid && w->priv.vl_n == w->n && w->priv.vl_nb == w->nb &&
+                w->priv.vl_sorts == w->priv.sorts && w->priv.vl_radius == rs && !w->priv.b_dirty;
+    if (reuse) {
+        sph_real m2 = sph__max_shift2(&w->priv.grid, w->x, w->priv.vl_x, w->n);
+        if (w->nb > 0) {
+            const sph_real b2 = sph__max_shift2(&w->priv.bgrid, w->b_x, w->priv.vl_bx, w->nb);
+            if (b2 > m2) m2 = b2;
+        }
+        reuse = m2 < half * half;
+    }
+    if (!reuse) {
+        s = sph__verlet_build(w, rs);
+        if (s != SPH_OK) return s;
+    } else if (w->nb > 0 && w->def.boundary_motion && w->def.boundary_volume == SPH_BVOL_AKINCI) {
+        /* moved walls, not sorted again: their volumes from the kept wall lists */
+        s = sph__stage_boundary_volume(w, rs, 0);
+        if (s != SPH_OK) return s;
+    }
+    s = sph__neighbors_filter(&w->priv.ff, &w->priv.cff, &w->priv.grid, w->x, w->x, R);
+    if (s == SPH_OK && w->nb > 0) {
+        s = sph__neighbors_filter(&w->priv.fb, &w->priv.cfb, &w->priv.bgrid, w->b_x, w->x, R);
+        if (s == SPH_OK)
+            s = sph__neighbors_filter(&w->priv.bf, &w->priv.cbf, &w->priv.grid, w->x, w->b_x, R);
+    }
+    if (s != SPH_OK) {
+        w->priv.vl_valid = 0;
+        return sph__fail(w, s, -1, "neighbour lists: %s", sph_status_string(s));
+    }
+    return SPH_OK;
+}
+
+/* Sort fluid (and moving boundary) particles by cell, then build the lists fluid->fluid,
+   fluid->boundary and boundary->fluid within R (no skin). */
+static sph_status sph__stage_neighbors_search(sph_world* w, sph_real R) {
+    sph__array arr[16];
+    sph_status s;
+    int narr;
+    w->priv.vl_valid = 0;
+    w->priv.vl_restore = 0;
+    if (w->priv.grid.cell != R) sph__grid_recell(w, &w->priv.grid, R); /* a skin was on */
+    if (w->priv.bgrid.cell != R) {
+        sph__grid_recell(w, &w->priv.bgrid, R);
+        w->priv.b_dirty = 1;
+    }
+    ++w->stats.neighbor_builds;
+    s = sph_grid_build(&w->priv.grid, w->x, w->n);
+    if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour grid: %s", sph_status_string(s));
+    narr = sph__fluid_arrays(w, arr);
+    sph__permute(w, arr, narr, w->priv.grid.order, w->n);
+    ++w->priv.sorts;
+    if (w->nb > 0 && (w->priv.b_dirty || w->def.boundary_motion)) {
+        s = sph_grid_build(&w->priv.bgrid, w->b_x, w->nb);
+        if (s != SPH_OK) return sph__fail(w, s, -1, "boundary grid: %s", sph_status_string(s));
+        narr = sph__boundary_arrays(w, arr);
+        sph__permute(w, arr, narr, w->priv.bgrid.order, w->nb);
+        if (w->def.boundary_volume == SPH_BVOL_AKINCI) {
+            s = sph__stage_boundary_volume(w, R, 1);
             if (s != SPH_OK) return s;
         }
         /* only now: out of memory for the Akinci volumes must leave the walls dirty, or static
@@ -4423,6 +4848,16 @@ static sph_status sph__stage_neighbors(sph_world* w) {
             s = sph__neighbors_build(&w->priv.bf, &w->priv.grid, w->x, NULL, w->b_x, w->nb, R, 0);
     }
     if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour lists: %s", sph_status_string(s));
+    return SPH_OK;
+}
+
+/* Neighbours stage: the lists fluid->fluid, fluid->boundary and boundary->fluid once for the
+   whole step, searched (and the particles sorted by cell) every step, or with
+   def.neighbor_skin filtered from candidate lists kept between steps. */
+static sph_status sph__stage_neighbors(sph_world* w) {
+    const sph_real R = w->kernel.radius, rs = sph__verlet_radius(w);
+    sph_status s = rs > R ? sph__stage_neighbors_skin(w, rs) : sph__stage_neighbors_search(w, R);
+    if (s != SPH_OK) return s;
     w->stats.pairs = w->priv.ff.total;
 #ifdef SPH_VALIDATE
     { /* every fluid pair is listed from both sides; and now and then (small worlds) the lists
@@ -7971,13 +8406,16 @@ static void sph__pbf_unpredict(sph_world* w, uint64_t sorts) {
 }
 
 /* After the sort: a_ext into ap (w->a is scratch, not sorted), x* into xp for the projections,
-   x back to x^n (to rounding) for the final move, and w->p cleared for its accumulation. */
-static void sph__pbf_begin(sph_world* w, sph_real dt) {
+   x back to x^n (to rounding) for the final move, and w->p cleared for its accumulation. The
+   sort's permutation applies only if the search sorted (sorts changed; def.neighbor_skin's
+   steps that keep their lists do not). */
+static void sph__pbf_begin(sph_world* w, sph_real dt, uint64_t sorts) {
     const size_t D = (size_t)w->dim;
+    const int sorted = w->priv.sorts != sorts;
     sph__idx i;
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) {
-        const size_t o = (size_t)w->priv.grid.order[i] * D;
+        const size_t o = (sorted ? (size_t)w->priv.grid.order[i] : (size_t)i) * D;
         size_t k;
         for (k = 0; k < D; ++k) {
             const size_t q = (size_t)i * D + k;
@@ -8043,7 +8481,7 @@ static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
         return s;
     }
     sph__pbf_setup(w, &c, &P, dt);
-    sph__pbf_begin(w, dt);
+    sph__pbf_begin(w, dt, sorts);
     sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
     /* project (lines 8-19): Jacobi, two passes each, between the buffers xp and vp */
     xa = w->priv.xp;
@@ -8376,7 +8814,10 @@ static int sph__snap_nfluid(sph_world* w) {
 static sph_status sph__snapshot_take(sph_world* w, int slot) {
     sph__array arr[32];
     sph__snap_head head;
-    const int walls = w->nb > 0 && (w->def.boundary_motion != NULL || w->priv.b_dirty);
+    /* the walls are re-sorted by a step when they move, were changed, or their cells change
+       size (def.neighbor_skin turned on, off or changed) */
+    const int walls = w->nb > 0 && (w->def.boundary_motion != NULL || w->priv.b_dirty ||
+                                    w->priv.bgrid.cell != sph__verlet_radius_for(w, (int)w->def.solver));
     const int na = sph__snap_arrays(w, arr, walls), nf = sph__snap_nfluid(w);
     size_t bytes = sizeof(head), pos;
     int k;
@@ -8423,8 +8864,10 @@ static void sph__snapshot_restore(sph_world* w, int slot) {
     w->steps = head.steps;
     w->priv.sorts = head.sorts;
     w->stats = head.stats;
-    w->priv.b_dirty = head.b_dirty;
+    /* walls put back into an order their grid may no longer have: sorted again */
+    w->priv.b_dirty = head.b_dirty || head.walls;
     w->priv.snl_valid = 0; /* the second-order scheme's lists name the order that was undone */
+    w->priv.vl_valid = 0;  /* and so may the candidate lists of def.neighbor_skin */
 }
 
 /* The step control of sph_advance (DESIGN: "the robust integrator"):
@@ -8916,7 +9359,9 @@ static int sph__soc_lists_saved(const sph_world* w) {
 /* Header and payload; the payload layout (after the fixed header):
      def (callback and user pointers zeroed), nphase, phases, time, steps, timings, counters,
      stats, every fluid array (elem size, n * elem bytes), every boundary array, then the
-     second-order lists (flag; total, xref, count, idx). The checksum follows. */
+     second-order lists (flag; total, xref, count, idx), then def.neighbor_skin's candidate
+     lists (flag; radius, the fluid and boundary positions of their search). The checksum
+     follows. */
 static void sph__save(const sph_world* w, sph__sink* o) {
     sph_world_def def = w->def;
     sph__array arr[16];
@@ -8977,6 +9422,18 @@ static void sph__save(const sph_world* w, sph__sink* o) {
         sph__put(o, xref, n * D * sizeof(sph_real));
         sph__put(o, nl->count, n * sizeof(uint32_t));
         for (i = 0; i < n; ++i) sph__put(o, nl->idx + nl->begin[i], nl->count[i] * sizeof(uint32_t));
+    } else {
+        sph__put_u32(o, 0);
+    }
+    /* def.neighbor_skin's candidate lists are state too (they decide when the particles are
+       sorted next): the positions they were searched at, from which a load searches them again
+       without sorting (sph__verlet_restore) */
+    if (((w->priv.vl_valid && w->priv.vl_sorts == w->priv.sorts) || w->priv.vl_restore) &&
+        w->priv.vl_n == n && w->priv.vl_nb == nb) {
+        sph__put_u32(o, 1);
+        sph__put(o, &w->priv.vl_radius, sizeof(sph_real));
+        sph__put(o, w->priv.vl_x, n * D * sizeof(sph_real));
+        sph__put(o, w->priv.vl_bx, nb * D * sizeof(sph_real));
     } else {
         sph__put_u32(o, 0);
     }
@@ -9255,6 +9712,7 @@ SPHDEF sph_status sph_world_load_mem(sph_world* w, const void* buf, size_t size,
     w->nb = nb;
     if (sph__check_loaded(w) != SPH_OK) return sph__load_reject(w, "");
     w->priv.b_dirty = nb > 0; /* the boundary grid (and Akinci volumes) are rebuilt */
+    w->priv.vl_valid = 0;
     if (!sph__get(&in, &soc, 4)) return sph__load_fail(w, SPH_ERR_IO, "truncated");
     if (soc) {
         sph_neighbors* nl = &w->priv.snl;
@@ -9287,6 +9745,29 @@ SPHDEF sph_status sph_world_load_mem(sph_world* w, const void* buf, size_t size,
         nl->total = (size_t)total;
         w->priv.snl_valid = 1;
         w->priv.snl_sorts = w->priv.sorts;
+    }
+    if (!sph__get(&in, &soc, 4) || soc > 1) return sph__load_fail(w, SPH_ERR_IO, "truncated");
+    if (soc) {
+        const size_t D = (size_t)w->dim;
+        sph_real r;
+        if (!sph__get(&in, &r, sizeof r) || !(r > w->kernel.radius) ||
+            !(r <= 2 * w->kernel.radius))
+            return sph__load_fail(w, SPH_ERR_IO, "bad neighbour list radius");
+        if (!sph__grow((void**)&w->priv.vl_x, w->capacity * D, sizeof(sph_real)) ||
+            !sph__grow((void**)&w->priv.vl_bx, w->b_capacity * D, sizeof(sph_real)))
+            return sph__load_fail(w, SPH_ERR_NOMEM, "out of memory");
+        w->priv.vl_x_cap = (w->capacity > 0 ? w->capacity : 1) * D;
+        w->priv.vl_bx_cap = (w->b_capacity > 0 ? w->b_capacity : 1) * D;
+        if (!sph__get(&in, w->priv.vl_x, n * D * sizeof(sph_real)) ||
+            !sph__get(&in, w->priv.vl_bx, nb * D * sizeof(sph_real)))
+            return sph__load_fail(w, SPH_ERR_IO, "truncated neighbour list positions");
+        for (i = 0; i < (n + nb) * D; ++i)
+            if (!sph__finite((double)(i < n * D ? w->priv.vl_x[i] : w->priv.vl_bx[i - n * D])))
+                return sph__load_fail(w, SPH_ERR_IO, "bad neighbour list positions");
+        w->priv.vl_restore = 1;
+        w->priv.vl_radius = r;
+        w->priv.vl_n = n;
+        w->priv.vl_nb = nb;
     }
     if (in.pos != in.size) return sph__load_fail(w, SPH_ERR_IO, "%zu unread bytes", in.size - in.pos);
     w->status = SPH_OK;

@@ -30,7 +30,8 @@
             --n N, --scene S, --solver S, --threads T, --repeats R, --steps K, --t-end T (tts:
             simulated seconds, default 1), --max-wall S, --precision double|float|all,
             --kernel default|cubic (tts: the cubic B-spline at h = dx and omega 0.5 instead of
-            the default kernel, the peer's support)
+            the default kernel, the peer's support), --skin S (tts: def.neighbor_skin = S, the
+            Verlet skin of the neighbour lists in support radii; 0 = search every step)
    Every timing is the median over the repeats of a wall-clock time per step; runs that are
    compared (ours against the baseline, double against float) alternate inside one repeat loop,
    so a slow minute on a shared machine hits both. tts is the exception: one run per cell (each
@@ -53,6 +54,7 @@ int bench_tts_f(int scene, int solver, int quick, double t_end, double max_wall,
                 tts_result* r);
 
 int bench_tts_kernel = 0;
+double bench_tts_skin = -2; /* --skin S: def.neighbor_skin of the tts scenes; -2: the default */
 
 typedef struct opts {
     int quick, repeats, steps, threads, threads_set, scene, solver;
@@ -793,6 +795,13 @@ int main(int argc, char** argv) {
                 bench_tts_kernel = 1;
             else {
                 fprintf(stderr, "bench: unknown --kernel %s (default, cubic)\n", v);
+                return 2;
+            }
+        }
+        else if (strcmp(a, "--skin") == 0) {
+            bench_tts_skin = atof(v);
+            if (!(bench_tts_skin == -1 || (bench_tts_skin >= 0 && bench_tts_skin <= 1))) {
+                fprintf(stderr, "bench: --skin %s: -1 (automatic) or in [0, 1]\n", v);
                 return 2;
             }
         }

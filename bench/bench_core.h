@@ -420,6 +420,7 @@ BENCH_FN int BX(tts_build)(sph_world* w, int scene, int solver, int quick) {
     default:
         break;
     }
+    if (bench_tts_skin >= -1) def.neighbor_skin = (sph_real)bench_tts_skin; /* --skin */
     if (bench_tts_kernel == 1) { /* --kernel cubic: the peer's support, 2 dx */
         def.kernel = SPH_KERNEL_CUBIC;
         def.h_factor = 1;

@@ -68,6 +68,7 @@ static const char* const tts_solver_names[TTS_NSOLVER] = {"wcsph", "pcisph-enh",
    h = dx with the Jacobi weight 0.5 in 3D (support 2 dx: 33 neighbours in 3D against 74, the
    peer's kernel; see README "Time to solution"). Defined in bench.c, read by both precisions. */
 extern int bench_tts_kernel;
+extern double bench_tts_skin;
 
 typedef struct tts_result {
     double n, nb;          /* fluid and wall particles                                          */

@@ -52,6 +52,7 @@ extern const th_test tests_layers[]; /* layered columns at rest (issue 18, item 
 extern const th_test tests_layers_long[];
 extern const th_test tests_rt[]; /* Rayleigh-Taylor linear growth (issue 18, item 2) */
 extern const th_test tests_rt_long[];
+extern const th_test tests_verlet[]; /* neighbour lists kept with a skin (issue 17, item 3) */
 
 void th_fail(const char* file, int line, const char* fmt, ...);
 void th_note(const char* fmt, ...);

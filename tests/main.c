@@ -38,7 +38,8 @@ int th_not_converged(void) { return th_nc; }
 static const th_test* const th_tables[] = {tests_kernels, tests_grid, tests_operators, tests_world, tests_io, tests_save, tests_reliability, tests_wcsph,
                                            tests_pcisph, tests_iisph, tests_dfsph, tests_pbf, tests_compressible, tests_soc,
                                            tests_compile, tests_oom, tests_validation, tests_scenes,
-                                           tests_hostile, tests_viscous, tests_layers, tests_rt};
+                                           tests_hostile, tests_viscous, tests_layers, tests_rt,
+                                           tests_verlet};
 static const th_test* const th_long_tables[] = {tests_pcisph_long, tests_iisph_long,
                                                 tests_compressible_long, tests_soc_long,
                                                 tests_reliability_long, tests_scenes_long,
