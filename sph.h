@@ -2506,40 +2506,52 @@ static sph_status sph__neighbors_nomem(sph_neighbors* nl) {
     return SPH_ERR_NOMEM;
 }
 
-static sph_status sph__neighbors_build(sph_neighbors* nl, const sph_grid* g, const sph_real* x,
-                                       const uint32_t* order, const sph_real* xq, size_t nq,
-                                       sph_real radius, int exclude_self) {
-    size_t c, nchunk = (nq + SPH__CHUNK - 1) / SPH__CHUNK, total_cap;
-    int pass;
+/* Room for nq lists in nchunk chunks (begin, count and the chunk tables; new chunks start with no
+   room of their own); sets n and nchunk. 0 when out of memory. */
+static int sph__neighbors_reserve(sph_neighbors* nl, size_t nq, size_t nchunk) {
+    size_t c;
     if (nq > nl->cap_n) {
         size_t cap = nq + nq / 4 + 16;
         if (!sph__grow((void**)&nl->begin, cap, sizeof(size_t)) ||
             !sph__grow((void**)&nl->count, cap, sizeof(uint32_t)))
-            return sph__neighbors_nomem(nl);
+            return 0;
         nl->cap_n = cap;
     }
     if (nchunk > nl->cap_chunk) {
         size_t cap = nchunk + nchunk / 4 + 4;
         if (!sph__grow((void**)&nl->chunk_off, cap + 1, sizeof(size_t)) ||
-            !sph__grow((void**)&nl->chunk_need, cap, sizeof(size_t)))
-            return sph__neighbors_nomem(nl);
-        if (!sph__grow((void**)&nl->chunk_cap, cap, sizeof(size_t))) return sph__neighbors_nomem(nl);
+            !sph__grow((void**)&nl->chunk_need, cap, sizeof(size_t)) ||
+            !sph__grow((void**)&nl->chunk_cap, cap, sizeof(size_t)))
+            return 0;
         for (c = nl->cap_chunk; c < cap; ++c) nl->chunk_cap[c] = 0;
         nl->cap_chunk = cap;
     }
     nl->n = nq;
     nl->nchunk = nchunk;
+    return 1;
+}
+
+/* Lays the chunk regions out back to back in idx, growing it to hold them. 0 when out of memory. */
+static int sph__neighbors_layout(sph_neighbors* nl) {
+    size_t c, total = 0;
+    for (c = 0; c < nl->nchunk; ++c) { nl->chunk_off[c] = total; total += nl->chunk_cap[c]; }
+    if (total > nl->cap_idx) {
+        if (!sph__grow((void**)&nl->idx, total, sizeof(uint32_t))) return 0;
+        nl->cap_idx = total;
+    }
+    return 1;
+}
+
+static sph_status sph__neighbors_build(sph_neighbors* nl, const sph_grid* g, const sph_real* x,
+                                       const uint32_t* order, const sph_real* xq, size_t nq,
+                                       sph_real radius, int exclude_self) {
+    size_t c, nchunk = (nq + SPH__CHUNK - 1) / SPH__CHUNK;
+    int pass;
+    if (!sph__neighbors_reserve(nl, nq, nchunk)) return sph__neighbors_nomem(nl);
     for (pass = 0; pass < 2; ++pass) {
         sph__idx ci;
         int overflow = 0;
-        /* lay the chunk regions out back to back */
-        total_cap = 0;
-        for (c = 0; c < nchunk; ++c) { nl->chunk_off[c] = total_cap; total_cap += nl->chunk_cap[c]; }
-        if (total_cap > nl->cap_idx) {
-            if (!sph__grow((void**)&nl->idx, total_cap, sizeof(uint32_t)))
-                return sph__neighbors_nomem(nl);
-            nl->cap_idx = total_cap;
-        }
+        if (!sph__neighbors_layout(nl)) return sph__neighbors_nomem(nl);
         const int fast = !order && !g->hashed && !g->periodic[0] && !g->periodic[1] &&
                          !g->periodic[2] && g->n > 0;
         SPH__OMP_FOR_DYNAMIC(nchunk)
@@ -2658,36 +2670,13 @@ static sph_status sph__neighbors_filter(sph_neighbors* nl, const sph_neighbors* 
                                         sph_real radius) {
     const sph_real r2max = radius * radius;
     const size_t nchunk = cand->nchunk, nq = cand->n;
-    size_t c, total_cap;
+    size_t c;
     int pass;
-    if (nq > nl->cap_n) {
-        size_t cap = nq + nq / 4 + 16;
-        if (!sph__grow((void**)&nl->begin, cap, sizeof(size_t)) ||
-            !sph__grow((void**)&nl->count, cap, sizeof(uint32_t)))
-            return sph__neighbors_nomem(nl);
-        nl->cap_n = cap;
-    }
-    if (nchunk > nl->cap_chunk) {
-        size_t cap = nchunk + nchunk / 4 + 4;
-        if (!sph__grow((void**)&nl->chunk_off, cap + 1, sizeof(size_t)) ||
-            !sph__grow((void**)&nl->chunk_need, cap, sizeof(size_t)))
-            return sph__neighbors_nomem(nl);
-        if (!sph__grow((void**)&nl->chunk_cap, cap, sizeof(size_t))) return sph__neighbors_nomem(nl);
-        for (c = nl->cap_chunk; c < cap; ++c) nl->chunk_cap[c] = 0;
-        nl->cap_chunk = cap;
-    }
-    nl->n = nq;
-    nl->nchunk = nchunk;
+    if (!sph__neighbors_reserve(nl, nq, nchunk)) return sph__neighbors_nomem(nl);
     for (pass = 0; pass < 2; ++pass) {
         sph__idx ci;
         int overflow = 0;
-        total_cap = 0;
-        for (c = 0; c < nchunk; ++c) { nl->chunk_off[c] = total_cap; total_cap += nl->chunk_cap[c]; }
-        if (total_cap > nl->cap_idx) {
-            if (!sph__grow((void**)&nl->idx, total_cap, sizeof(uint32_t)))
-                return sph__neighbors_nomem(nl);
-            nl->cap_idx = total_cap;
-        }
+        if (!sph__neighbors_layout(nl)) return sph__neighbors_nomem(nl);
         SPH__OMP_FOR_DYNAMIC(nchunk)
         for (ci = 0; ci < (sph__idx)nchunk; ++ci) {
             size_t need;
