@@ -2542,15 +2542,31 @@ static int sph__neighbors_layout(sph_neighbors* nl) {
     return 1;
 }
 
+/* After a pass: 1 if a chunk needed more room than it had (its room is then grown for the second
+   pass), else 0 with nl->total set to the number of pairs listed. */
+static int sph__neighbors_room(sph_neighbors* nl) {
+    size_t c;
+    int overflow = 0;
+    for (c = 0; c < nl->nchunk; ++c) {
+        if (nl->chunk_need[c] > nl->chunk_cap[c]) {
+            overflow = 1;
+            nl->chunk_cap[c] = nl->chunk_need[c] + nl->chunk_need[c] / 4 + 16;
+        }
+    }
+    nl->total = 0;
+    if (!overflow)
+        for (c = 0; c < nl->nchunk; ++c) nl->total += nl->chunk_need[c];
+    return overflow;
+}
+
 static sph_status sph__neighbors_build(sph_neighbors* nl, const sph_grid* g, const sph_real* x,
                                        const uint32_t* order, const sph_real* xq, size_t nq,
                                        sph_real radius, int exclude_self) {
-    size_t c, nchunk = (nq + SPH__CHUNK - 1) / SPH__CHUNK;
+    const size_t nchunk = (nq + SPH__CHUNK - 1) / SPH__CHUNK;
     int pass;
     if (!sph__neighbors_reserve(nl, nq, nchunk)) return sph__neighbors_nomem(nl);
     for (pass = 0; pass < 2; ++pass) {
         sph__idx ci;
-        int overflow = 0;
         if (!sph__neighbors_layout(nl)) return sph__neighbors_nomem(nl);
         const int fast = !order && !g->hashed && !g->periodic[0] && !g->periodic[1] &&
                          !g->periodic[2] && g->n > 0;
@@ -2567,17 +2583,9 @@ static sph_status sph__neighbors_build(sph_neighbors* nl, const sph_grid* g, con
                 need = sph__neighbors_chunk(nl, g, x, order, xq, nq, radius, exclude_self, (size_t)ci);
             nl->chunk_need[ci] = need;
         }
-        for (c = 0; c < nchunk; ++c) {
-            if (nl->chunk_need[c] > nl->chunk_cap[c]) {
-                overflow = 1;
-                nl->chunk_cap[c] = nl->chunk_need[c] + nl->chunk_need[c] / 4 + 16;
-            }
-        }
-        if (!overflow) break;
+        if (!sph__neighbors_room(nl)) break;
         SPH_ASSERT(pass == 0); /* the second pass has room for every chunk */
     }
-    nl->total = 0;
-    for (c = 0; c < nchunk; ++c) nl->total += nl->chunk_need[c];
     return SPH_OK;
 }
 
@@ -2670,12 +2678,10 @@ static sph_status sph__neighbors_filter(sph_neighbors* nl, const sph_neighbors* 
                                         sph_real radius) {
     const sph_real r2max = radius * radius;
     const size_t nchunk = cand->nchunk, nq = cand->n;
-    size_t c;
     int pass;
     if (!sph__neighbors_reserve(nl, nq, nchunk)) return sph__neighbors_nomem(nl);
     for (pass = 0; pass < 2; ++pass) {
         sph__idx ci;
-        int overflow = 0;
         if (!sph__neighbors_layout(nl)) return sph__neighbors_nomem(nl);
         SPH__OMP_FOR_DYNAMIC(nchunk)
         for (ci = 0; ci < (sph__idx)nchunk; ++ci) {
@@ -2685,17 +2691,9 @@ static sph_status sph__neighbors_filter(sph_neighbors* nl, const sph_neighbors* 
             else need = sph__neighbors_filter_chunk(nl, cand, g, x, xq, r2max, (size_t)ci, 1);
             nl->chunk_need[ci] = need;
         }
-        for (c = 0; c < nchunk; ++c) {
-            if (nl->chunk_need[c] > nl->chunk_cap[c]) {
-                overflow = 1;
-                nl->chunk_cap[c] = nl->chunk_need[c] + nl->chunk_need[c] / 4 + 16;
-            }
-        }
-        if (!overflow) break;
+        if (!sph__neighbors_room(nl)) break;
         SPH_ASSERT(pass == 0); /* the second pass has room for every chunk */
     }
-    nl->total = 0;
-    for (c = 0; c < nchunk; ++c) nl->total += nl->chunk_need[c];
     return SPH_OK;
 }
 
