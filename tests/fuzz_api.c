@@ -14,7 +14,10 @@
      - when the force callback writes NaN for a particle that exists, the next step fails
        (SPH_ERR_UNSTABLE) naming that particle and the callback;
      - sph_stable_dt returns a finite value >= 0 (0 with a message).
-   Work is bounded: at most 1500 fluid and 3000 wall particles, 12 steps, 30 solver iterations.
+   Work is bounded: at most 1500 fluid and 3000 wall particles, 12 steps or sph_advance calls of at
+   most 48 sub-steps each (def.max_substeps; retries and restarts included: a scene whose flow
+   itself passes the speed limit fails every retry, and the default budget of 100000 sub-steps
+   is minutes under the sanitizers), 30 solver iterations.
 
    INPUT LAYOUT (bytes beyond the end read as 0)
      def      dim byte, solver byte, integrator byte, spacing real (3 bytes)
@@ -157,8 +160,7 @@ static void fza_step(fza_ctx* c, unsigned op) {
     }
     if (op == 9) {
         /* a few stable steps, or a bad duration (0, negative, NaN, infinite); a huge finite one
-           would run for hours (its sub-step budget is sph_advance's business, not this
-           harness's) */
+           would only spend the sub-step budget (def.max_substeps, SPH_ERR_BUDGET) */
         double dur = isfinite(f) && f > 0 ? (f < 3 ? 2 * f : 4) * (double)dt : f;
         s = sph_advance(w, (sph_real)dur);
     } else {
@@ -335,6 +337,7 @@ int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     if (b & 4u) d.density = SPH_DENSITY_SUMMATION;
     d.spacing = (sph_real)fzc_real(&c->r, 0.02, 0.005, 0.1);
     d.max_iterations = 30;
+    d.max_substeps = 48;
     if (d.min_iterations > 30) d.min_iterations = 30;
     if (sph_world_init(&c->w, &d) != SPH_OK) {
         FZC_ASSERT(c->w.error[0] != 0 && c->w.n == 0, "init failed without a message");

@@ -18,7 +18,7 @@
        velocities, densities and pressures (blow-ups are SPH_ERR_UNSTABLE).
    The work is bounded: at most FZ_MAX_FLUID fluid and FZ_MAX_WALL wall particles (fewer with a
    large h_factor or the second-order scheme), at most 10 steps, iteration limits of at most 40,
-   sph_advance over at most a few stable steps.
+   sph_advance over at most a few stable steps in at most 48 sub-steps (def.max_substeps).
 
    INPUT LAYOUT (bytes beyond the end read as 0; a 0 byte always means "the default")
      def      20 one-byte fields, then 29 reals of 3 bytes (see fz_def)
@@ -332,6 +332,7 @@ static void fz_def(fz_ctx* c) {
     if (c->motion.mode < 0 || c->motion.mode > 3) c->motion.mode = 0;
     d->min_iterations = fz_int(r, d->min_iterations);
     d->max_iterations = fz_int(r, d->max_iterations > 40 ? 40 : d->max_iterations);
+    d->max_substeps = 48; /* not from the input: bounds each sph_advance (retries included) */
     d->shift_every = fz_int(r, d->shift_every);
     /* 29 reals */
     d->spacing = (sph_real)fz_real(r, (double)d->spacing, 1e-3, 0.5);
