@@ -3516,12 +3516,21 @@ static sph_status sph__check_phase_fields(sph_world* w, sph_phase* ph, int saved
                     "sph_phase.sound_speed = %g: an ideal gas's sound speed follows from gamma, "
                     "back_pressure and rest_density (here %g m/s); leave it 0",
                     (double)ph->sound_speed, c);
+        SPH__PCHECK(sph__finite((double)(sph_real)c),
+                    "sph_phase: an ideal gas's sound speed sqrt(gamma back_pressure / "
+                    "rest_density) = sqrt(%g * %g / %g) is not finite (in sph_real)",
+                    (double)ph->gamma, (double)ph->back_pressure, (double)ph->rest_density);
         ph->sound_speed = (sph_real)c;
     }
     if (ph->eos == SPH_EOS_STIFFENED_GAS) {
         SPH__PCHECK(ph->sound_speed > 0,
                     "sph_phase.sound_speed = 0: a stiffened gas needs its sound speed at rest "
                     "density (it sets p_inf)");
+        SPH__PCHECK(sph__finite((double)sph__pinf(ph)),
+                    "sph_phase: a stiffened gas's p_inf = rho0 c0^2 / gamma - back_pressure = "
+                    "%g * %g^2 / %g - %g Pa is not finite (in sph_real)",
+                    (double)ph->rest_density, (double)ph->sound_speed, (double)ph->gamma,
+                    (double)ph->back_pressure);
         SPH__PCHECK(sph__pinf(ph) >= 0,
                     "sph_phase: a stiffened gas with rho0 c0^2 / gamma = %g Pa below its "
                     "back_pressure %g Pa would have p_inf < 0; raise sound_speed or use an ideal gas",
