@@ -4656,13 +4656,56 @@ static sph_real sph__max_shift2(const sph_grid* g, const sph_real* x, const sph_
     return m;
 }
 
+/* The particles sorted by cell, in cells of `cell` (the grids re-celled if theirs differ): the
+   fluid always, the walls when they moved or were added (or re-celled), with their Akinci
+   volumes recomputed then. Shared by the search with and without a skin. */
+static sph_status sph__sort_by_cell(sph_world* w, sph_real cell) {
+    sph__array arr[16];
+    sph_status s;
+    int narr;
+    if (w->priv.grid.cell != cell) sph__grid_recell(w, &w->priv.grid, cell);
+    if (w->priv.bgrid.cell != cell) { /* the walls are sorted again into the new cells */
+        sph__grid_recell(w, &w->priv.bgrid, cell);
+        w->priv.b_dirty = 1;
+    }
+    s = sph_grid_build(&w->priv.grid, w->x, w->n);
+    if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour grid: %s", sph_status_string(s));
+    narr = sph__fluid_arrays(w, arr);
+    sph__permute(w, arr, narr, w->priv.grid.order, w->n);
+    ++w->priv.sorts;
+    if (w->nb > 0 && (w->priv.b_dirty || w->def.boundary_motion)) {
+        s = sph_grid_build(&w->priv.bgrid, w->b_x, w->nb);
+        if (s != SPH_OK) return sph__fail(w, s, -1, "boundary grid: %s", sph_status_string(s));
+        narr = sph__boundary_arrays(w, arr);
+        sph__permute(w, arr, narr, w->priv.bgrid.order, w->nb);
+        if (w->def.boundary_volume == SPH_BVOL_AKINCI) {
+            s = sph__stage_boundary_volume(w, cell, 1);
+            if (s != SPH_OK) return s;
+        }
+        /* only now: out of memory for the Akinci volumes must leave the walls dirty, or static
+           walls would keep their given volumes for good */
+        w->priv.b_dirty = 0;
+    }
+    return SPH_OK;
+}
+
+/* The lists fluid->fluid, fluid->boundary and boundary->fluid within r, from the sorted grids. */
+static sph_status sph__neighbors_lists(sph_world* w, sph_neighbors* ff, sph_neighbors* fb,
+                                       sph_neighbors* bf, sph_real r) {
+    sph_status s = sph__neighbors_build(ff, &w->priv.grid, w->x, NULL, w->x, w->n, r, 1);
+    if (s == SPH_OK && w->nb > 0) {
+        s = sph__neighbors_build(fb, &w->priv.bgrid, w->b_x, NULL, w->x, w->n, r, 0);
+        if (s == SPH_OK) s = sph__neighbors_build(bf, &w->priv.grid, w->x, NULL, w->b_x, w->nb, r, 0);
+    }
+    if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour lists: %s", sph_status_string(s));
+    return SPH_OK;
+}
+
 /* def.neighbor_skin's search: the particles sorted by cell (cells of the candidate radius rs),
    candidate lists within rs, and the positions they were built at. */
 static sph_status sph__verlet_build(sph_world* w, sph_real rs) {
     const size_t D = (size_t)w->dim;
-    sph__array arr[16];
     sph_status s;
-    int narr;
     w->priv.vl_valid = 0;
     /* the build positions' room first: out of memory here changes nothing */
     if (w->n * D > w->priv.vl_x_cap) {
@@ -4677,34 +4720,10 @@ static sph_status sph__verlet_build(sph_world* w, sph_real rs) {
             return sph__fail(w, SPH_ERR_NOMEM, -1, "out of memory (neighbour lists)");
         w->priv.vl_bx_cap = cap;
     }
-    if (w->priv.grid.cell != rs) sph__grid_recell(w, &w->priv.grid, rs);
-    if (w->priv.bgrid.cell != rs) { /* the walls are sorted again into the new cells */
-        sph__grid_recell(w, &w->priv.bgrid, rs);
-        w->priv.b_dirty = 1;
-    }
-    s = sph_grid_build(&w->priv.grid, w->x, w->n);
-    if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour grid: %s", sph_status_string(s));
-    narr = sph__fluid_arrays(w, arr);
-    sph__permute(w, arr, narr, w->priv.grid.order, w->n);
-    ++w->priv.sorts;
-    if (w->nb > 0 && (w->priv.b_dirty || w->def.boundary_motion)) {
-        s = sph_grid_build(&w->priv.bgrid, w->b_x, w->nb);
-        if (s != SPH_OK) return sph__fail(w, s, -1, "boundary grid: %s", sph_status_string(s));
-        narr = sph__boundary_arrays(w, arr);
-        sph__permute(w, arr, narr, w->priv.bgrid.order, w->nb);
-        if (w->def.boundary_volume == SPH_BVOL_AKINCI) {
-            s = sph__stage_boundary_volume(w, rs, 1);
-            if (s != SPH_OK) return s;
-        }
-        w->priv.b_dirty = 0;
-    }
-    s = sph__neighbors_build(&w->priv.cff, &w->priv.grid, w->x, NULL, w->x, w->n, rs, 1);
-    if (s == SPH_OK && w->nb > 0) {
-        s = sph__neighbors_build(&w->priv.cfb, &w->priv.bgrid, w->b_x, NULL, w->x, w->n, rs, 0);
-        if (s == SPH_OK)
-            s = sph__neighbors_build(&w->priv.cbf, &w->priv.grid, w->x, NULL, w->b_x, w->nb, rs, 0);
-    }
-    if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour lists: %s", sph_status_string(s));
+    s = sph__sort_by_cell(w, rs);
+    if (s != SPH_OK) return s;
+    s = sph__neighbors_lists(w, &w->priv.cff, &w->priv.cfb, &w->priv.cbf, rs);
+    if (s != SPH_OK) return s;
     sph__copy(w->priv.vl_x, w->x, w->n * D * sizeof(sph_real));
     sph__copy(w->priv.vl_bx, w->b_x, w->nb * D * sizeof(sph_real));
     w->priv.vl_valid = 1;
@@ -4808,43 +4827,13 @@ static sph_status sph__stage_neighbors_skin(sph_world* w, sph_real rs) {
 /* Sort fluid (and moving boundary) particles by cell, then build the lists fluid->fluid,
    fluid->boundary and boundary->fluid within R (no skin). */
 static sph_status sph__stage_neighbors_search(sph_world* w, sph_real R) {
-    sph__array arr[16];
     sph_status s;
-    int narr;
     w->priv.vl_valid = 0;
     w->priv.vl_restore = 0;
-    if (w->priv.grid.cell != R) sph__grid_recell(w, &w->priv.grid, R); /* a skin was on */
-    if (w->priv.bgrid.cell != R) {
-        sph__grid_recell(w, &w->priv.bgrid, R);
-        w->priv.b_dirty = 1;
-    }
     ++w->stats.neighbor_builds;
-    s = sph_grid_build(&w->priv.grid, w->x, w->n);
-    if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour grid: %s", sph_status_string(s));
-    narr = sph__fluid_arrays(w, arr);
-    sph__permute(w, arr, narr, w->priv.grid.order, w->n);
-    ++w->priv.sorts;
-    if (w->nb > 0 && (w->priv.b_dirty || w->def.boundary_motion)) {
-        s = sph_grid_build(&w->priv.bgrid, w->b_x, w->nb);
-        if (s != SPH_OK) return sph__fail(w, s, -1, "boundary grid: %s", sph_status_string(s));
-        narr = sph__boundary_arrays(w, arr);
-        sph__permute(w, arr, narr, w->priv.bgrid.order, w->nb);
-        if (w->def.boundary_volume == SPH_BVOL_AKINCI) {
-            s = sph__stage_boundary_volume(w, R, 1);
-            if (s != SPH_OK) return s;
-        }
-        /* only now: out of memory for the Akinci volumes must leave the walls dirty, or static
-           walls would keep their given volumes for good */
-        w->priv.b_dirty = 0;
-    }
-    s = sph__neighbors_build(&w->priv.ff, &w->priv.grid, w->x, NULL, w->x, w->n, R, 1);
-    if (s == SPH_OK && w->nb > 0) {
-        s = sph__neighbors_build(&w->priv.fb, &w->priv.bgrid, w->b_x, NULL, w->x, w->n, R, 0);
-        if (s == SPH_OK)
-            s = sph__neighbors_build(&w->priv.bf, &w->priv.grid, w->x, NULL, w->b_x, w->nb, R, 0);
-    }
-    if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour lists: %s", sph_status_string(s));
-    return SPH_OK;
+    s = sph__sort_by_cell(w, R); /* cells of R (a skin, if one was on, had larger cells) */
+    if (s != SPH_OK) return s;
+    return sph__neighbors_lists(w, &w->priv.ff, &w->priv.fb, &w->priv.bf, R);
 }
 
 /* Neighbours stage: the lists fluid->fluid, fluid->boundary and boundary->fluid once for the
