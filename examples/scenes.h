@@ -309,6 +309,36 @@ SCENE_FN sph_status scene_taylor_green(sph_world* w, sph_world_def def, int N, d
     return SPH_OK;
 }
 
+/* A closed box of water without gravity (a square of side L, N particles across, walls on all
+   sides by sph_add_wall_box), set turning as one cell of the vortex u = sin(pi x/L) cos(pi y/L),
+   v = -cos(pi x/L) sin(pi y/L) (zero normal velocity on the walls; with free-slip walls its
+   kinetic energy decays as exp(-4 pi^2 nu t / L^2), the Stokes decay of the mode). Water:
+   rho0 1000, kinematic viscosity nu, sound speed c0 (0: automatic). */
+SCENE_FN sph_status scene_vortex_box(sph_world* w, sph_world_def def, double L, int N, double nu,
+                                     double c0) {
+    sph_real lo[2] = {0, 0}, hi[2];
+    sph_phase water;
+    size_t i;
+    hi[0] = hi[1] = (sph_real)L;
+    def.dim = 2;
+    def.spacing = (sph_real)(L / N);
+    def.gravity[0] = def.gravity[1] = 0;
+    memset(&water, 0, sizeof(water));
+    water.rest_density = 1000;
+    water.viscosity = (sph_real)nu;
+    water.sound_speed = (sph_real)c0;
+    SCENE__TRY(sph_world_init(w, &def));
+    if (sph_world_add_phase(w, &water) < 0) return scene__fail(w, w->status);
+    SCENE__TRY(sph_fill_box(w, 0, lo, hi));
+    SCENE__TRY(sph_add_wall_box(w, lo, hi, 0, 0));
+    for (i = 0; i < w->n; ++i) {
+        const double x = (double)w->x[2 * i] / L, y = (double)w->x[2 * i + 1] / L;
+        w->v[2 * i] = (sph_real)(sin(SCENE_TG_PI * x) * cos(SCENE_TG_PI * y));
+        w->v[2 * i + 1] = (sph_real)(-cos(SCENE_TG_PI * x) * sin(SCENE_TG_PI * y));
+    }
+    return SPH_OK;
+}
+
 /* Errors against the exact solution at w->time: mean |(|u| - |u_exact|)| and mean |p - p_exact|
    with the mean pressure removed (a weakly compressible run carries a constant offset), both
    over the particles (Negi & Ramachandran 2022 eq. 36 at one instant); ke_ratio = kinetic energy /

@@ -718,28 +718,13 @@ static void test_pcisph_orig_box_frames(void) {
     for (k = 0; k < 2; ++k) {
         sph_world_def def = sph_world_def_default(2);
         sph_world w;
-        sph_phase water;
-        sph_real lo[2] = {0, 0}, hi[2] = {1, 1};
         double ke0, ke_prev, rise = 0;
         int f, n = (int)(0.5 / frames[k] + 0.5);
         sph_status s = SPH_OK;
         size_t i;
-        memset(&water, 0, sizeof water);
-        water.rest_density = 1000;
-        water.viscosity = (sph_real)0.01;
         sph_world_def_pcisph(&def, 0);
         def.solver = SPH_SOLVER_PCISPH;
-        def.spacing = (sph_real)0.04;
-        def.gravity[1] = 0;
-        CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
-        CHECK(sph_world_add_phase(&w, &water) == 0);
-        CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
-        CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 0, 0), SPH_OK);
-        for (i = 0; i < w.n; ++i) {
-            const double x = (double)w.x[2 * i], y = (double)w.x[2 * i + 1];
-            w.v[2 * i] = (sph_real)(sin(SCENE_TG_PI * x) * cos(SCENE_TG_PI * y));
-            w.v[2 * i + 1] = (sph_real)(-cos(SCENE_TG_PI * x) * sin(SCENE_TG_PI * y));
-        }
+        CHECK_EQ_INT(scene_vortex_box(&w, def, 1, 25, 0.01, 0), SPH_OK);
         ke0 = 0;
         for (i = 0; i < 2 * w.n; ++i) ke0 += 0.5 * (double)w.mass * (double)w.v[i] * (double)w.v[i];
         ke_prev = ke0;

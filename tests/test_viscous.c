@@ -133,31 +133,18 @@ static decay_result run_box_decay(sph_solver solver, int N, double alpha, double
     const double nu = 0.01, L = 1, exact = 4 * SCENE_TG_PI * SCENE_TG_PI * nu / (L * L);
     sph_world_def def = sph_world_def_default(2);
     sph_world w;
-    sph_phase water;
-    sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)L, (sph_real)L};
     decay_result r;
     double st = 0, sy = 0, stt = 0, sty = 0, ns = 0, ke0 = 0, ke = 0;
     int f, frames = (int)(t_end / frame + 0.5);
     size_t i;
     memset(&r, 0, sizeof r);
-    memset(&water, 0, sizeof water);
-    water.rest_density = 1000;
-    water.viscosity = (sph_real)nu;
     if (solver == SPH_SOLVER_PCISPH) sph_world_def_pcisph(&def, 0);
     def.solver = solver;
     def.alpha = (sph_real)alpha;
-    def.spacing = (sph_real)(L / N);
-    def.gravity[1] = 0;
-    if (sph_world_init(&w, &def) != SPH_OK || sph_world_add_phase(&w, &water) != 0 ||
-        sph_fill_box(&w, 0, lo, hi) != SPH_OK || sph_add_wall_box(&w, lo, hi, 0, 0) != SPH_OK) {
-        th_fail(__FILE__, __LINE__, "box setup: %s", w.error);
-        r.status = w.status;
+    r.status = scene_vortex_box(&w, def, L, N, nu, 0);
+    if (r.status != SPH_OK) {
+        th_fail(__FILE__, __LINE__, "box setup: %s", scene_error);
         return r;
-    }
-    for (i = 0; i < w.n; ++i) {
-        const double x = (double)w.x[2 * i] / L, y = (double)w.x[2 * i + 1] / L;
-        w.v[2 * i] = (sph_real)(sin(SCENE_TG_PI * x) * cos(SCENE_TG_PI * y));
-        w.v[2 * i + 1] = (sph_real)(-cos(SCENE_TG_PI * x) * sin(SCENE_TG_PI * y));
     }
     for (i = 0; i < 2 * w.n; ++i) ke0 += 0.5 * (double)w.v[i] * (double)w.v[i];
     st = 0; sy = log(ke0); stt = 0; sty = 0; ns = 1;
@@ -281,29 +268,12 @@ static void test_momentum_conserved(void) {
 static uint64_t viscous_box_hash(sph_solver solver, int threads) {
     sph_world_def def = sph_world_def_default(2);
     sph_world w;
-    sph_phase water;
-    sph_real lo[2] = {0, 0}, hi[2] = {1, 1};
     uint64_t hash;
-    size_t i;
     int k;
     omp_set_num_threads(threads);
-    memset(&water, 0, sizeof water);
-    water.rest_density = 1000;
-    water.viscosity = (sph_real)0.01;
-    water.sound_speed = 10;
     def.solver = solver;
-    def.spacing = (sph_real)(1.0 / 60);
-    def.gravity[1] = 0;
     def.wall = SPH_WALL_NO_SLIP;
-    CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
-    CHECK(sph_world_add_phase(&w, &water) == 0);
-    CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
-    CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 0, 0), SPH_OK);
-    for (i = 0; i < w.n; ++i) {
-        const double x = (double)w.x[2 * i], y = (double)w.x[2 * i + 1];
-        w.v[2 * i] = (sph_real)(sin(SCENE_TG_PI * x) * cos(SCENE_TG_PI * y));
-        w.v[2 * i + 1] = (sph_real)(-cos(SCENE_TG_PI * x) * sin(SCENE_TG_PI * y));
-    }
+    CHECK_EQ_INT(scene_vortex_box(&w, def, 1, 60, 0.01, 10), SPH_OK);
     for (k = 0; k < 10; ++k) CHECK_EQ_INT(th_step(&w, sph_stable_dt(&w, solver)), SPH_OK);
     CHECK(w.n > 2048);
     hash = th_state_hash(&w);
