@@ -3174,19 +3174,31 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
     return SPH_OK;
 }
 
-/* dx^dim sum_j W(|x_j|) over a square lattice of spacing dx, the particle itself included:
-   the summation density of a lattice in units of m / dx^dim (1.0105 for Wendland C2, 2D,
-   h = 1.3 dx). */
-static sph_real sph__lattice_sum(const sph_kernel* k, sph_real dx) {
+/* Sums over a square lattice of spacing dx around a particle at the origin (itself included),
+   times dx^dim: of W(|x_j|) (SPH__LATTICE_W) or of -|x_j| dW/dr(|x_j|) (SPH__LATTICE_RDW). */
+typedef enum sph__lattice_term { SPH__LATTICE_W, SPH__LATTICE_RDW } sph__lattice_term;
+static double sph__lattice(const sph_kernel* k, sph_real dx, sph__lattice_term term) {
     const int R = (int)(k->radius / dx) + 1, D = k->dim;
     double sum = 0, vol = 1;
     int i, j, l;
     for (i = 0; i < D; ++i) vol *= (double)dx;
     for (i = -R; i <= R; ++i)
         for (j = (D > 1 ? -R : 0); j <= (D > 1 ? R : 0); ++j)
-            for (l = (D > 2 ? -R : 0); l <= (D > 2 ? R : 0); ++l)
-                sum += (double)sph_kernel_w(k, dx * sph__sqrt((sph_real)(i * i + j * j + l * l)));
-    return (sph_real)(sum * vol);
+            for (l = (D > 2 ? -R : 0); l <= (D > 2 ? R : 0); ++l) {
+                const int q = i * i + j * j + l * l;
+                const double r = (double)dx * sqrt((double)q);
+                sum += term == SPH__LATTICE_W
+                           ? (double)sph_kernel_w(k, dx * sph__sqrt((sph_real)q))
+                           : -r * (double)sph_kernel_dwdr(k, (sph_real)r);
+            }
+    return sum * vol;
+}
+
+/* dx^dim sum_j W(|x_j|) over a square lattice of spacing dx, the particle itself included:
+   the summation density of a lattice in units of m / dx^dim (1.0105 for Wendland C2, 2D,
+   h = 1.3 dx). */
+static sph_real sph__lattice_sum(const sph_kernel* k, sph_real dx) {
+    return (sph_real)sph__lattice(k, dx, SPH__LATTICE_W);
 }
 
 /* The first moment of the kernel gradient over a square lattice of spacing dx (the particle at
@@ -3197,17 +3209,7 @@ static sph_real sph__lattice_sum(const sph_kernel* k, sph_real dx) {
    replaces the integral: the hydrostatic pressure that the gradient balances with gravity is
    then 2.7 % too steep (sph__ctx_init's pg_norm). */
 static sph_real sph__lattice_grad(const sph_kernel* k, sph_real dx) {
-    const int R = (int)(k->radius / dx) + 1, D = k->dim;
-    double sum = 0, vol = 1;
-    int i, j, l;
-    for (i = 0; i < D; ++i) vol *= (double)dx;
-    for (i = -R; i <= R; ++i)
-        for (j = (D > 1 ? -R : 0); j <= (D > 1 ? R : 0); ++j)
-            for (l = (D > 2 ? -R : 0); l <= (D > 2 ? R : 0); ++l) {
-                const double r = (double)dx * sqrt((double)(i * i + j * j + l * l));
-                sum -= r * (double)sph_kernel_dwdr(k, (sph_real)r);
-            }
-    return (sph_real)(sum * vol / D);
+    return (sph_real)(sph__lattice(k, dx, SPH__LATTICE_RDW) / k->dim);
 }
 
 /* The wall volume fraction that check_walls allows (see sph__wall_fraction): that of a particle
