@@ -8877,7 +8877,7 @@ static void sph__snapshot_restore(sph_world* w, int slot) {
 SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
     double t_end;
     int substeps = 0, retries = 0, in_row = 0, restarts = 0, first = 1;
-    double dt_min = 0, iterations = 0, factor0;
+    double dt_min = 0, dt_last = 0, iterations = 0, factor0;
     sph_status s;
     if (!w) return SPH_ERR_ARG;
     if (!sph__finite((double)duration) || duration < 0)
@@ -8900,9 +8900,9 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
         if (substeps >= w->def.max_substeps) {
             sph__snapshot_restore(w, 0);
             return sph__fail(w, SPH_ERR_BUDGET, -1,
-                             "sph_advance: %d sub-steps (def.max_substeps) reached %g s short of "
-                             "the end, at a step of %g s; the world is as before the call",
-                             substeps, remaining, w->stats.dt);
+                             "sph_advance: %d sub-steps (def.max_substeps, %d retries) reached "
+                             "%g s short of the end, the last at a step of %g s; the world is as "
+                             "before the call", substeps, retries, remaining, dt_last);
         }
         dt_stable = (double)sph_stable_dt(w, w->def.solver);
         if (!(dt_stable > 0)) {
@@ -8941,6 +8941,7 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
             }
         }
         ++substeps;
+        dt_last = dt;
         w->priv.correct_fraction = fmin(1.0, w->stats.dt_factor);
         if (w->priv.dt_unpressed > 4 * dt_stable)
             w->priv.correct_fraction *= 4 * dt_stable / w->priv.dt_unpressed;
