@@ -3782,6 +3782,7 @@ static sph_status sph__append_boundary(sph_world* w, size_t n, const sph_real* x
         w->b_vol[j] = vol[i];
         w->b_p[j] = 0;
         w->b_rho[j] = 1;
+        w->priv.b_sw[j] = 0; /* saved with the world: a step without fluid does not set it */
         w->b_id[j] = w->b_next_id++;
         w->b_body[j] = (uint16_t)body;
     }
