@@ -30,7 +30,10 @@ FUZZ_DEFS    ?=
 # float-cast-overflow: gcc's -fsanitize=undefined leaves it out (clang's includes it)
 FUZZ_SAN      = -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all \
                 -fno-omit-frame-pointer
-FUZZ_RUN      = ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1
+# malloc_fill_byte=255: every allocation starts as NaN in both precisions (ASan's default fill,
+# 0xbe, reads as a finite number), so state a call leaves unset cannot pass as a value
+FUZZ_RUN      = ASAN_OPTIONS=detect_leaks=1:malloc_fill_byte=255:max_malloc_fill_size=1000000000 \
+                UBSAN_OPTIONS=print_stacktrace=1
 FUZZ_INPUTS   = $(wildcard tests/fuzz_corpus/regressions/*.bin) $(wildcard tests/fuzz_corpus/seed-*.bin)
 FUZZ_INPUTS_LOAD = $(wildcard tests/fuzz_corpus/regressions/load/*.bin) $(wildcard tests/fuzz_corpus/load/*.bin)
 FUZZ_INPUTS_API  = $(wildcard tests/fuzz_corpus/regressions/api/*.bin) $(wildcard tests/fuzz_corpus/api/*.bin)
