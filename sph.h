@@ -477,11 +477,12 @@ int main(void) {
    WHAT IT DOES NOT DO (yet)
    No surface tension, no turbulence model, no rigid-body coupling (boundaries move kinematically),
    no adaptive resolution, no GPU. A 1000:1 interface does not stay at rest for long: with
-   periodic sides it breaks up after about 2 s, touching side walls (square lattice) after about
-   1.5 s, both through a slowly growing zig-zag of the water's top row away from the walls (the
-   hexagonal lattice of the periodic test does not fit square walls and breaks within 0.2 s);
-   a 1000:1 dam break runs through, but its front is not that of one phase
-   (tests/test_compressible.c).
+   periodic sides it breaks up after about 2 s (a slowly growing zig-zag of the water's top row),
+   touching side walls (square lattice) after about 1.5 s, away from the walls (the hexagonal
+   lattice of the periodic test does not fit square walls and breaks within 0.2 s);
+   a 1000:1 dam break runs through, its front near the one-phase front (within 0.23 a until
+   T = 2.5), but its air reaches 3.3 sqrt(2 g a) and a water film runs ahead of the front
+   after that (the interfaces at rest: tests/test_compressible.c; the dam break: README, limitations).
 
    REFERENCES
    Comments cite these as "Author Year, eq./sec./Table N", numbered as in the work itself.

@@ -1024,24 +1024,27 @@ static rest_result contact_line_run(double t_end, double t_late, int* escapes) {
 }
 
 /* The force balance at the contact line at the start (see contact_line_force_defect: measured
-   2.4e-4 m/s^2, 3.66 m/s^2 before each wall particle stood for one phase), then 0.5 s through
-   sph_advance: no frame returns SPH_OK with a particle outside, no interface row moves by 1 dx,
+   2.4e-4 m/s^2, float 0.16, and 3.66 m/s^2 before each wall particle stood for one phase), then
+   0.5 s through sph_advance: no frame returns SPH_OK with a particle outside, no interface row
+   moves by 1 dx,
    and from 0.3 s on (after the start-up ringing: sph_set_hydrostatic leaves the air's bottom
    row with its pressure gradient twice its weight, +9.7 m/s^2 on the first step, as in the
    periodic box above) the water stays below 5 % of sqrt(g H). Measured: water 0.016 sqrt(g H),
    rise 0.22 dx, sink 0.21 dx. The air's own speed is reported, not asserted: 0.29 sqrt(g H)
    from 0.3 s on, 0.48 before the change (its square lattice under a background pressure 0.09
    of rho c^2 rearranges, walls or not). How long it stays at rest (runs to 3 s, these criteria
-   from 0.5 s on): the interface breaks up at 1.5 s (1.575 s before the change) through the
-   mode that also ends the periodic test above, a zig-zag of the water's top row (every other
-   particle up) that grows away from the walls; the issue's 10 s are not met. */
+   from 0.5 s on): the interface breaks up at 1.5 s (1.575 s before the change), away from the
+   walls, as the periodic test above does after about 2 s (there through a zig-zag of the
+   water's top row, every other particle up); the issue's 10 s are not met. */
 static void test_contact_line(void) {
     const double dev = contact_line_force_defect();
     int escapes;
     rest_result r;
     TH_NOTE("contact line, first step: largest difference from the row's acceleration in the "
             "middle %.3g m/s^2", dev);
-    CHECK(dev >= 0 && dev < 0.02 * 9.81);
+    /* the air's pair terms are each about p_b / (rho_a dx) = 8e4 m/s^2 and cancel to g: in float
+       their round-off alone leaves 0.16 m/s^2 (double 2.4e-4) */
+    CHECK(dev >= 0 && dev < (sizeof(sph_real) == 8 ? 1e-3 : 0.05) * 9.81);
     r = contact_line_run(0.5, 0.3, &escapes);
     TH_NOTE("contact line, side walls: status %d, t = %.3f s; from 0.3 s water %.4f, air %.4f of "
             "sqrt(g H) (air %.4f over the run); water rose %.2f dx, air sank %.2f dx%s%s",
