@@ -426,7 +426,8 @@ int main(void) {
    SOLVER: COMPRESSIBLE (sph_step_compressible, or def.solver = SPH_SOLVER_COMPRESSIBLE)
    Explicit compressible multiphase SPH (Ott & Schnetter 2003): density by continuity
    (use def.density = SPH_DENSITY_PARTICLE, eq. 11, when phases of very different density meet),
-   momentum by def.pressure_grad (SPH_PGRAD_MULTIPHASE is eq. 12), internal energy w.e [J/kg] by
+   momentum by def.pressure_grad (SPH_PGRAD_MULTIPHASE is eq. 12; SPH_PGRAD_VOLUME for 1000:1
+   interfaces, see PHASES), internal energy w.e [J/kg] by
    eq. 13 written so that total energy is conserved to round-off, Monaghan 1992 artificial
    viscosity with each particle's own sound speed. Per phase equation of state: Tait or linear
    (no energy), SPH_EOS_IDEAL_GAS p = (gamma - 1) rho e (c0 follows from back_pressure, the
@@ -437,7 +438,8 @@ int main(void) {
    and densities: put equal spacing and unequal masses across a density jump. Validated against
    Ott & Schnetter's advection, sound-wave and air | Diesel shock-tube tests, Toro's Riemann
    solutions and a 1000:1 interface at rest (tests/test_compressible.c). With multiphase walls each
-   phase sees a wall pressure extrapolated from its own particles only.
+   phase's wall pressure is extrapolated from its own particles only, and each wall particle
+   acts as fluid of the phase of its nearest fluid particle (the phase that wets the wall there).
 
    PHASES (several fluids of different rest density)
    Recommended for layered or mixing liquids with density ratios down to 0.1: particle-density
@@ -471,13 +473,26 @@ int main(void) {
    tests/test_pcisph.c),
    or run without resting: WCSPH symmetric with continuity 7 % and PBF 72 % of sqrt(g H) after
    0.5 s. None loses a particle silently (tests/test_layers.c checks every frame). Gases and
-   1000:1 interfaces: the compressible step (SOLVER: COMPRESSIBLE).
+   1000:1 interfaces: the compressible step (SOLVER: COMPRESSIBLE) with particle density and
+   def.pressure_grad = SPH_PGRAD_VOLUME, the momentum equation of the particle density (Hu &
+   Adams 2006's (p_i/n_i^2 + p_j/n_j^2) with n = 1/V), a background pressure in both phases and
+   an air stiffness rho c^2 about ten times it (tests/test_compressible.c, contact_line: water
+   1000 and air 1 kg/m^3, 2000 Pa, c 44 and 150 m/s). Measured on water under air in a closed
+   box, dx = 0.025 m, through sph_advance: at rest for 10 s (water at most 0.018 sqrt(g H)
+   after 0.5 s, interface rows within 0.62 dx, no particle outside; the air: see WHAT IT DOES
+   NOT DO); the dam break of Martin & Moyce's column in air follows the column alone within
+   0.041 a (one spacing is 0.1 a) to T = 3, no water particle more than 1.16 dx from the
+   water, air at most 2.2 sqrt(2 g a) (water 1.36). With Hu & Adams' density-weighted pair
+   pressure (SPH_PGRAD_INTERFACE) the same interface breaks up after 1.5-2 s and the dam
+   break's front is off by 0.3-0.6 a.
 
    WHAT IT DOES NOT DO (yet)
    No surface tension, no turbulence model, no rigid-body coupling (boundaries move kinematically),
-   no adaptive resolution, no GPU. A 1000:1 interface touching a side wall does not stay at rest
-   (the contact line breaks up within 0.2 s); with periodic sides it stays at rest for about 2 s,
-   then a slowly growing mode breaks it (tests/test_compressible.c).
+   no adaptive resolution, no GPU. At a 1000:1 interface at rest the air is not quiet: on the
+   square lattice of sph_fill_box under a background pressure the air's rows rearrange now and
+   then (up to 0.28 sqrt(g H) over 10 s, with the water under it at 0.018), and a host-placed hexagonal lattice does not fit the square wall lattice of
+   sph_add_wall_box (thrown about within 0.05 s). SPH_PGRAD_INTERFACE does not hold 1000:1 for
+   long (see PHASES).
 
    REFERENCES
    Comments cite these as "Author Year, eq./sec./Table N", numbered as in the work itself.
@@ -811,7 +826,7 @@ typedef enum sph_pressure_grad {
                                 (Hu & Adams 2006; Adami, Hu & Adams 2013 eq. 7-8): eq. 12 inside
                                 a phase; at an interface the light side sees its own pressure,
                                 which holds a 1000:1 interface under gravity                    */
-    SPH_PGRAD_DIFFERENCE     /* sum_j m_j (p_j - p_i)/(rho_i rho_j) grad W_ij: the multiphase form
+    SPH_PGRAD_DIFFERENCE,    /* sum_j m_j (p_j - p_i)/(rho_i rho_j) grad W_ij: the multiphase form
                                 without its zeroth-order error 2 p_i sum_j V_j grad W_ij, so a
                                 uniform pressure exerts no force on any particle arrangement and
                                 rows of particles slide past each other freely (buoyancy-driven
@@ -821,6 +836,12 @@ typedef enum sph_pressure_grad {
                                 only to the discretisation error. WCSPH only (sph_world_init
                                 rejects it for the other solvers: PCISPH's gain and the
                                 compressible step's energy need the antisymmetric forms)       */
+    SPH_PGRAD_VOLUME         /* 1/m_i sum_j (V_i^2 p_i + V_j^2 p_j) grad W_ij, V = m/rho: the pair
+                                term Hu & Adams 2006 derive with the particle number density
+                                1/V, the momentum equation that goes with Ott & Schnetter's
+                                particle-density continuity (eq. 10-11: dV_i/dt and the work of
+                                the pressure forces cancel pair by pair). With it the
+                                compressible step holds a 1000:1 interface at rest (PHASES)   */
 } sph_pressure_grad;
 
 typedef enum sph_integrator {
@@ -3111,7 +3132,7 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
                (double)d->pbf_compression);
     SPH__CHECK((int)d->density >= 0 && d->density <= SPH_DENSITY_PARTICLE,
                "sph_world_def.density = %d: not a sph_density", (int)d->density);
-    SPH__CHECK((int)d->pressure_grad >= 0 && d->pressure_grad <= SPH_PGRAD_DIFFERENCE,
+    SPH__CHECK((int)d->pressure_grad >= 0 && d->pressure_grad <= SPH_PGRAD_VOLUME,
                "sph_world_def.pressure_grad = %d: not a sph_pressure_grad", (int)d->pressure_grad);
     SPH__CHECK(d->pressure_grad != SPH_PGRAD_DIFFERENCE || d->solver == SPH_SOLVER_WCSPH,
                "sph_world_def.pressure_grad = SPH_PGRAD_DIFFERENCE: WCSPH only (solver %d)",
@@ -4128,7 +4149,25 @@ typedef struct sph__ctx {
    al.'s eq. 27 over all fluid neighbours would carry the dense phase's hydrostatic gradient
    across the interface (at 1000:1 a wall particle beside the air, one spacing above the water,
    gets -rho_w g dx, hundreds of pascals below the air's pressure, and pulls the air into the
-   wall). Each phase sees the wall extrapolated from its own particles only. */
+   wall). Each phase's wall pressure is extrapolated from its own particles only.
+   Which phase a wall particle stands for: Adami et al.'s wall particles continue the fluid
+   beside them across the wall, so where an interface meets a wall (a contact line) a wall
+   particle continues the phase that wets the wall there, not the phase of the particle it
+   pushes. Every wall particle therefore stands for the phase of its nearest fluid particle
+   (in a flat wall: the fluid row at its height), with that phase's extrapolated pressure and
+   density and its rest density's mass rho0_q V_b, and acts on every fluid particle through the
+   pair term of def.pressure_grad as a fluid particle of that phase would (with the interface
+   and multiphase forms the water then sees the air's pressure on the wall beside the air, and
+   the air sees the wall beside the water through the density-weighted pair pressure, as it
+   sees the water itself). Before, each particle saw the wall as its own phase: the water's
+   extrapolation reached up the wall beside the air (falling by rho_w g per metre, where the air
+   falls by rho_a g) and the air's down the wall beside the water, so the rows at a contact line
+   did not feel the forces of the same rows away from the wall. Measured on a 1000:1 interface
+   at rest in a closed box (tests/test_compressible.c, contact_line; square lattice, dx 0.025 m):
+   the largest difference from the row's acceleration in the middle of the box at the first
+   step 3.66 m/s^2 (the air at the corner pulled into the wall), now 2.4e-4. A wall particle
+   without fluid neighbours stands for no phase and is never asked. */
+#define SPH__BPQ 3 /* reals per wall particle and phase in w->priv.bpq: p_b, rho_b/rho0, share */
 static int sph__phase_walls_for(const sph_world* w, int solver) {
     return w->nphase > 1 && w->nb > 0 && w->def.boundary_pressure == SPH_BP_EXTRAPOLATE &&
            (solver == SPH_SOLVER_WCSPH || solver == SPH_SOLVER_COMPRESSIBLE);
@@ -4172,7 +4211,8 @@ static void sph__ctx_init(sph_world* w, sph__ctx* c) {
        lattice sum): the rows then within 0.2 % away from the interfaces (1.2 % on the row next to
        one). The symmetric form, the default of one-phase scenes, is left as it was. */
     c->pg_norm = 1;
-    if ((c->pgrad == SPH_PGRAD_MULTIPHASE || c->pgrad == SPH_PGRAD_INTERFACE) &&
+    if ((c->pgrad == SPH_PGRAD_MULTIPHASE || c->pgrad == SPH_PGRAD_INTERFACE ||
+         c->pgrad == SPH_PGRAD_VOLUME) &&
         w->priv.lattice_grad > 0)
         c->pg_norm = 1 / w->priv.lattice_grad;
     c->noslip = w->def.wall == SPH_WALL_NO_SLIP;
@@ -4250,9 +4290,9 @@ static void sph__stage_wall(sph_world* w, const sph__ctx* c, int parts) {
         const size_t bD = (size_t)b * (size_t)D;
         const sph_real* xb = c->bx + bD;
         sph_real sw = 0, swp = 0, sgx = 0, srr = 0, sv[3] = {0, 0, 0}, wph[SPH_MAX_PHASES];
-        sph_real qp[SPH_MAX_PHASES], qg[SPH_MAX_PHASES];
+        sph_real qp[SPH_MAX_PHASES], qg[SPH_MAX_PHASES], rmin = 0;
         size_t kk, k0 = nl->begin[b], k1 = k0 + nl->count[b];
-        int k, q;
+        int k, q, qnear = -1;
         for (q = 0; q < c->nphase; ++q) wph[q] = qp[q] = qg[q] = 0;
         for (kk = k0; kk < k1; ++kk) {
             const size_t f = nl->idx[kk], fD = f * (size_t)D;
@@ -4266,6 +4306,10 @@ static void sph__stage_wall(sph_world* w, const sph__ctx* c, int parts) {
                 for (k = 0; k < D; ++k) /* rho_f (g_f - a_b) . x_bf W_bf */
                     sgx += c->rho[f] * (w->a[fD + (size_t)k] - w->b_a[bD + (size_t)k]) * d[k] * W;
                 wph[c->ph[f]] += W;
+                if (qnear < 0 || r2 < rmin || (r2 == rmin && (int)c->ph[f] < qnear)) {
+                    rmin = r2;
+                    qnear = c->ph[f];
+                }
                 if (c->bpq) { /* the same sums per phase */
                     qp[c->ph[f]] += c->p[f] * W;
                     for (k = 0; k < D; ++k)
@@ -4297,12 +4341,13 @@ static void sph__stage_wall(sph_world* w, const sph__ctx* c, int parts) {
                 w->b_rho[b] = 1;
             }
             w->b_p[b] = pb;
-            if (c->bpq) /* per phase; a phase without neighbours here is never asked */
+            if (c->bpq) /* per phase, and the phase it stands for (share 1, see sph__phase_walls) */
                 for (q = 0; q < c->nphase; ++q) {
                     const sph_real pq = wph[q] > 0 ? (qp[q] + qg[q]) / wph[q] : pb;
-                    c->bpq[((size_t)b * (size_t)c->nphase + (size_t)q) * 2] = pq;
-                    c->bpq[((size_t)b * (size_t)c->nphase + (size_t)q) * 2 + 1] =
-                        sph__eos_inverse(&c->pc[q], pq);
+                    sph_real* o = c->bpq + ((size_t)b * (size_t)c->nphase + (size_t)q) * SPH__BPQ;
+                    o[0] = pq;
+                    o[1] = sph__eos_inverse(&c->pc[q], pq);
+                    o[2] = q == qnear ? 1 : 0;
                 }
         }
     }
@@ -5000,7 +5045,7 @@ static int sph__visc_norm_used(const sph_world* w) {
 /* The wall's density relative to rest as fluid particle i of relative density rhati sees it (the
    boundary scheme's, see sph__interact_one). */
 SPH__INLINE sph_real sph__wall_kappa(const sph__ctx* c, size_t b, size_t i, sph_real rhati) {
-    if (c->bpq) return c->bpq[((size_t)b * (size_t)c->nphase + c->ph[i]) * 2 + 1];
+    if (c->bpq) return c->bpq[((size_t)b * (size_t)c->nphase + c->ph[i]) * SPH__BPQ + 1];
     return c->bp_mode == SPH_BP_EXTRAPOLATE ? c->brho[b] : rhati;
 }
 
@@ -5096,6 +5141,38 @@ SPH__INLINE sph_real sph__pgrad_interface(sph_real mi, sph_real rhoi, sph_real p
                                           sph_real rhoj, sph_real pj) {
     const sph_real Vi = mi / rhoi, Vj = mj / rhoj;
     return -(Vi * Vi + Vj * Vj) / mi * (rhoj * pi + rhoi * pj) / (rhoi + rhoj);
+}
+
+/* SPH_PGRAD_VOLUME's pair term: -(V_i^2 p_i + V_j^2 p_j)/m_i, the factor of grad W_ij in the
+   acceleration of i. With V = 1/n this is -(p_i/n_i^2 + p_j/n_j^2)/m_i, the form a Lagrangian
+   sum_i m_i (v_i^2/2 - u_i(n_i)) gives when n_i = sum_j W_ij (Hu & Adams 2006): its work on a
+   pair, (p_i V_i^2 + p_j V_j^2) v_ij . grad W_ij, is what particle-density continuity (Ott &
+   Schnetter 2003 eq. 10: dV_i/dt = -V_i^2 sum_j v_ij . grad W_ij) takes from the internal energy
+   p dV, so energy is exchanged only between a particle and its own pressure. Hu & Adams'
+   density-weighted pair pressure (SPH_PGRAD_INTERFACE) breaks that pairing: at a 1000:1
+   interface the air sees its own pressure across a water pair, the water the air's, and the
+   work done on one side is not the work taken from the other. Measured (tests/
+   test_compressible.c, water under air in the compressible step): the interface form breaks up
+   after about 2 s (periodic sides) or 1.5 s (side walls); this form holds for 10 s with side
+   walls (water at most 0.018 sqrt(g H)), and with periodic sides (hexagonal lattice) the speeds
+   fall to 0.0014 sqrt(g H) by 5 s (a driver, not in the tests). */
+SPH__INLINE sph_real sph__pgrad_volume(sph_real mi, sph_real rhoi, sph_real pi, sph_real mj,
+                                       sph_real rhoj, sph_real pj) {
+    const sph_real Vi = mi / rhoi, Vj = mj / rhoj;
+    return -(Vi * Vi * pi + Vj * Vj * pj) / mi;
+}
+
+/* The pressure term of fluid particle i (mass mi, density rhoi, pressure pi, pi_r2 = pi / rhoi^2)
+   with a wall particle that stands for fluid of mass psi, density rhob and pressure pb: the
+   factor of grad W_ib in i's acceleration, in the form def.pressure_grad gives fluid pairs. */
+SPH__INLINE sph_real sph__wall_pterm(const sph__ctx* c, int pgrad, sph_real mi, sph_real rhoi,
+                                     sph_real inv_rhoi, sph_real pi, sph_real pi_r2, sph_real psi,
+                                     sph_real rhob, sph_real pb) {
+    if (pgrad == SPH_PGRAD_SYMMETRIC) return -psi * (pi_r2 + pb / (rhob * rhob));
+    if (pgrad == SPH_PGRAD_MULTIPHASE) return -psi * (pi + pb) * inv_rhoi / rhob * c->pg_norm;
+    if (pgrad == SPH_PGRAD_DIFFERENCE) return -psi * (pb - pi) * inv_rhoi / rhob;
+    if (pgrad == SPH_PGRAD_VOLUME) return sph__pgrad_volume(mi, rhoi, pi, psi, rhob, pb) * c->pg_norm;
+    return sph__pgrad_interface(mi, rhoi, pi, psi, rhob, pb) * c->pg_norm;
 }
 
 /* delta-SPH's difference for a pair of different phases (i's phase P). In a fluid at rest the
@@ -5262,6 +5339,7 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
                                     : (fast && c->pr2c) ? c->pr2c[j] : pj / (rhoj * rhoj)));
             else if (pgrad == SPH_PGRAD_MULTIPHASE) s = -mj * (pi + pj) * inv_rhoi / rhoj * c->pg_norm;
             else if (pgrad == SPH_PGRAD_DIFFERENCE) s = -mj * (pj - pi) * inv_rhoi / rhoj;
+            else if (pgrad == SPH_PGRAD_VOLUME) s = sph__pgrad_volume(mi, rhoi, pi, mj, rhoj, pj) * c->pg_norm;
             else s = sph__pgrad_interface(mi, rhoi, pi, mj, rhoj, pj) * c->pg_norm;
         }
         if (flags & SPH__VISCOUS) {
@@ -5301,7 +5379,7 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
             const sph_real Vb = c->bvol[b], psi = P->rho0 * Vb;
             /* the wall's density and pressure as the boundary scheme gives them */
             const sph_real* bq =
-                bpqa ? bpqa + ((size_t)b * (size_t)c->nphase + c->ph[i]) * 2 : NULL;
+                bpqa ? bpqa + ((size_t)b * (size_t)c->nphase + c->ph[i]) * SPH__BPQ : NULL;
             const sph_real kap = bq ? bq[1] : c->bp_mode == SPH_BP_EXTRAPOLATE ? c->brho[b] : rhati;
             const sph_real rhob = P->rho0 * kap;
             sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, ud = 0, fw, s = 0, lm = 0, ug = 0;
@@ -5321,10 +5399,17 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
                 const sph_real pb = bq ? bq[0] : c->bp_mode == SPH_BP_EXTRAPOLATE ? c->bp[b]
                                     : c->bp_mode == SPH_BP_MIRROR    ? pi
                                                                      : 0;
-                if (pgrad == SPH_PGRAD_SYMMETRIC) s = -psi * (pi_r2 + pb / (rhob * rhob));
-                else if (pgrad == SPH_PGRAD_MULTIPHASE) s = -psi * (pi + pb) * inv_rhoi / rhob * c->pg_norm;
-                else if (pgrad == SPH_PGRAD_DIFFERENCE) s = -psi * (pb - pi) * inv_rhoi / rhob;
-                else s = sph__pgrad_interface(mi, rhoi, pi, psi, rhob, pb) * c->pg_norm;
+                if (bq) { /* as fluid of the phase the wall stands for here (sph__phase_walls) */
+                    const sph_real* bb = bpqa + (size_t)b * (size_t)c->nphase * SPH__BPQ;
+                    int q;
+                    for (q = 0; q < c->nphase; ++q, bb += SPH__BPQ)
+                        if (bb[2] > 0)
+                            s += bb[2] * sph__wall_pterm(c, pgrad, mi, rhoi, inv_rhoi, pi, pi_r2,
+                                                         c->pc[q].rho0 * Vb,
+                                                         c->pc[q].rho0 * bb[1], bb[0]);
+                } else {
+                    s = sph__wall_pterm(c, pgrad, mi, rhoi, inv_rhoi, pi, pi_r2, psi, rhob, pb);
+                }
             }
             if ((flags & SPH__VISCOUS) && c->noslip && (laminar || c->av)) {
                 const sph_real* vw = c->bvw + b * (size_t)D;
@@ -6278,7 +6363,7 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
     /* scratch first, so that running out of memory here changes nothing */
     s = sph__reserve_blocks(w);
     if (s == SPH_OK && sph__phase_walls_for(w, (int)solver))
-        s = sph__scratch(w, &w->priv.bpq, w->nb * (size_t)w->nphase * 2);
+        s = sph__scratch(w, &w->priv.bpq, w->nb * (size_t)w->nphase * SPH__BPQ);
     if (s == SPH_OK && sph__visc_norm_used(w)) s = sph__scratch(w, &w->priv.lapc, w->capacity);
     if (s != SPH_OK) return s;
     s = sph__resolve_sound_speed(w);
