@@ -991,13 +991,13 @@ typedef struct sph_world_def {
                                   [0, 1]. Acts in the continuity and particle density rates, not
                                   in IISPH or the second-order scheme                            */
     sph_real alpha;            /* Monaghan artificial viscosity alpha [-]; default 0.02; [0, 10]  */
+    sph_real beta;             /* Monaghan artificial viscosity beta [-]; default 0; [0, 10]      */
     sph_real shifting;         /* particle shifting coefficient A [-] (see >>wcsph,
                                   sph__stage_shift): each WCSPH step moves fluid particle i by
                                   -A h U dt sum_j V_j (1 + 0.2 (W_ij/W(dx))^4) grad W_ij, U the
                                   last step's largest speed; 4 is Sun et al. 2017's delta+-SPH.
                                   Default 0 (off); [0, 10]; WCSPH, standard scheme. No free-
                                   surface treatment: for flows that fill their walls          */
-    sph_real beta;             /* Monaghan artificial viscosity beta [-]; default 0; [0, 10]      */
     sph_viscosity_form viscosity_form; /* laminar viscosity operator; default SPH_VISC_MORRIS    */
     sph_wall wall;             /* default SPH_WALL_FREE_SLIP                                      */
     sph_boundary_pressure boundary_pressure; /* default SPH_BP_AUTO (see there)                   */
