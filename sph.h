@@ -142,7 +142,12 @@ int main(void) {
    density, the multiphase (or interface) pressure gradient holds layers at rest (see PHASES),
    while SPH_PGRAD_DIFFERENCE lets buoyancy-driven interfaces move as they should (Rayleigh-Taylor
    growth within 7 % of the viscous theory at Atwood 0.5 and 0.29, where the antisymmetric forms
-   grow 3-10 times too slowly, tests/test_rt.c; it fails, reported, on the 10:1 column); delta-SPH
+   grow 3-10 times too slowly, tests/test_rt.c; it fails, reported, on the 10:1 column). Once
+   the interface mixes, that gradient needs def.shifting = 4 (particle shifting, Sun et al.
+   2017; see sph__stage_shift): on He, Chen & Zhang's 1999 Rayleigh-Taylor case (Atwood 0.5,
+   Re 256) it fails without it at t sqrt(g/W) = 1.3-2.3 (a particle compressed by 20 %, sooner
+   at finer resolution), and with it reaches t sqrt(g/W) = 3: the spike 0.11, 0.07 and 0.04 W
+   behind their position at 32, 64 and 128 particles across W, the bubble within 0.04 W. delta-SPH
    diffuses pressure, not rho/rho0, across a phase interface. Viscosity: Monaghan's
    artificial viscosity (alpha = 0.02 by default) and a laminar viscosity per phase (Morris et al.
    1997 by default, or the 2(d+2) form of Enhanced PCISPH 2018 eq. 2.5); see VISCOSITY below
@@ -447,6 +452,8 @@ int main(void) {
      - enhanced PCISPH, sph_world_def_pcisph(&def, 1), which brings the multiphase gradient; or
      - WCSPH with def.pressure_grad = SPH_PGRAD_MULTIPHASE (eq. 12) or SPH_PGRAD_INTERFACE (Hu &
        Adams 2006).
+   For interfaces that should overturn (Rayleigh-Taylor; the antisymmetric gradients slow them
+   down 2-3 times): WCSPH with SPH_PGRAD_DIFFERENCE and def.shifting = 4 (see WCSPH).
    Both gradients are divided by the kernel gradient's lattice moment (0.974 for Wendland C2 at
    h = 1.3 dx in 2D), so that the pressure they balance with gravity is the hydrostatic one
    (without it 2.7 % too steep in every layer). Measured (tests/test_layers.c: 1000/500/100
@@ -1006,6 +1013,12 @@ typedef struct sph_world_def {
                                   in IISPH or the second-order scheme                            */
     sph_real alpha;            /* Monaghan artificial viscosity alpha [-]; default 0.02; [0, 10]  */
     sph_real beta;             /* Monaghan artificial viscosity beta [-]; default 0; [0, 10]      */
+    sph_real shifting;         /* particle shifting coefficient A [-] (see >>wcsph,
+                                  sph__stage_shift): each WCSPH step moves fluid particle i by
+                                  -A h U dt sum_j V_j (1 + 0.2 (W_ij/W(dx))^4) grad W_ij, U the
+                                  last step's largest speed; 4 is Sun et al. 2017's delta+-SPH.
+                                  Default 0 (off); [0, 10]; WCSPH, standard scheme. No free-
+                                  surface treatment: for flows that fill their walls          */
     sph_viscosity_form viscosity_form; /* laminar viscosity operator; default SPH_VISC_MORRIS    */
     sph_wall wall;             /* default SPH_WALL_FREE_SLIP                                      */
     sph_boundary_pressure boundary_pressure; /* default SPH_BP_AUTO (see there)                   */
@@ -1241,6 +1254,8 @@ typedef struct sph__private {
     size_t pr2_cap;
     sph_real* vol;                  /* WCSPH: m_i / rho_i (scratch)                               */
     size_t vol_cap;
+    sph_real* shift;                /* WCSPH with def.shifting: each particle's shift (scratch)   */
+    size_t shift_cap;
     sph_real *xp, *vp;              /* PCISPH: predicted positions and velocities (scratch)         */
     size_t xp_cap, vp_cap;
     sph_real *de, *cs, *vn;         /* compressible: energy rate, sound speed, v at the step start  */
@@ -3142,6 +3157,12 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
     SPH__CHECK((int)d->scheme >= 0 && d->scheme <= SPH_SCHEME_SECOND_ORDER,
                "sph_world_def.scheme = %d: not a sph_wcsph_scheme", (int)d->scheme);
     SPH__CHECK(d->shift_every >= 0, "sph_world_def.shift_every = %d: must be >= 0", d->shift_every);
+    SPH__CHECK(sph__finite((double)d->shifting) && d->shifting >= 0 && d->shifting <= 10,
+               "sph_world_def.shifting = %g: must be in [0, 10]", (double)d->shifting);
+    SPH__CHECK(d->shifting == 0 || (d->solver == SPH_SOLVER_WCSPH &&
+                                    d->scheme == SPH_SCHEME_STANDARD),
+               "sph_world_def.shifting = %g: WCSPH with SPH_SCHEME_STANDARD only (the second-order "
+               "scheme shifts by def.shift_every)", (double)d->shifting);
     SPH__CHECK((int)d->clamp >= 0 && d->clamp <= SPH_CLAMP_OFF,
                "sph_world_def.clamp = %d: not a sph_pressure_clamp", (int)d->clamp);
     SPH__CHECK((int)d->viscosity_form >= 0 && d->viscosity_form <= SPH_VISC_MONAGHAN,
@@ -3396,6 +3417,7 @@ SPHDEF void sph_world_free(sph_world* w) {
     SPH_FREE(w->priv.fb_fw);
     SPH_FREE(w->priv.pr2);
     SPH_FREE(w->priv.vol);
+    SPH_FREE(w->priv.shift);
     SPH_FREE(w->priv.xp);
     SPH_FREE(w->priv.vp);
     SPH_FREE(w->priv.de);
@@ -4013,6 +4035,7 @@ SPHDEF size_t sph_world_memory(const sph_world* w) {
               w->priv.df_alpha_cap + w->priv.df_alpha_v_cap + w->priv.df_vs_cap +
               w->priv.df_kv_cap + w->priv.df_pv_cap +
               w->priv.ff_fw_cap + w->priv.fb_fw_cap + w->priv.pr2_cap + w->priv.vol_cap +
+              w->priv.shift_cap +
               w->priv.xp_cap +
               w->priv.vp_cap + w->priv.de_cap + w->priv.cs_cap + w->priv.vn_cap + w->priv.bpq_cap + w->priv.soc_cap + w->priv.socw_cap +
               w->priv.lapc_cap) *
@@ -4519,6 +4542,7 @@ static sph_status sph__scratch(sph_world* w, sph_real** p, size_t count) {
                   : p == &w->priv.fb_fw ? &w->priv.fb_fw_cap
                   : p == &w->priv.pr2   ? &w->priv.pr2_cap
                   : p == &w->priv.vol   ? &w->priv.vol_cap
+                  : p == &w->priv.shift ? &w->priv.shift_cap
                   : p == &w->priv.xp    ? &w->priv.xp_cap
                   : p == &w->priv.vp    ? &w->priv.vp_cap
                   : p == &w->priv.de    ? &w->priv.de_cap
@@ -6474,6 +6498,73 @@ static sph_status sph__rate_cache(sph_world* w, sph__ctx* c) {
     return SPH_OK;
 }
 
+/* Particle shifting (def.shifting = A > 0), after the step's last neighbour pass, at the positions
+   of its lists: fluid particle i moves by
+       dr_i = -A h U dt sum_j V_j (1 + R (W_ij / W(dx))^n) grad_i W_ij,   R = 0.2, n = 4,
+   over fluid and wall neighbours (V_j = m_j / rho_j, a wall particle's volume), U the largest fluid
+   speed of the last step: Lind et al. 2012 (J. Comput. Phys. 231, 1499), the gradient of the
+   particle concentration with their anti-clumping term, with the step-size scaling of Sun et al.
+   2017 (Comput. Methods Appl. Mech. Engrg. 315, 25, delta+-SPH: CFL Ma (2h)^2 with dt = CFL h / c0
+   and Ma = U / c0 is 4 h U dt, so A = 4 is theirs). Why: the pressure-difference gradient
+   (SPH_PGRAD_DIFFERENCE) is consistent but exerts no force against pairing and is not the adjoint
+   of the continuity divergence, so it conserves no acoustic energy; on the disordered particles of
+   a mixing layer its pressure noise grows until a particle is compressed past def.max_compression
+   (tests/test_rt.c, the Rayleigh-Taylor late phase). The shift keeps the particles ordered; it is
+   first order in h U dt per step and moves no particle of a fluid at rest (U = 0). Density and
+   velocity are not corrected for the shift (an error of the shift's order). A free surface would
+   pull its particles outwards (no surface detection here): for flows that fill their walls. Gather
+   only: each particle writes its own shift, then all move. */
+static sph_status sph__shift_reserve(sph_world* w) {
+    if (!(w->def.shifting > 0)) return SPH_OK;
+    return sph__scratch(w, &w->priv.shift, w->capacity * (size_t)w->dim);
+}
+
+static void sph__stage_shift(sph_world* w, const sph__ctx* c, sph_real dt) {
+    const int D = c->dim, form = c->k.form;
+    const sph_real inv_wdx = 1 / sph__kw(form, w->dx * c->k.inv_h);
+    const sph_real coef = -w->def.shifting * c->h * (sph_real)w->stats.v_max * dt;
+    sph_real* sh = w->priv.shift;
+    sph__idx i;
+    if (!(w->def.shifting > 0) || !(coef < 0)) return;
+    SPH__OMP_FOR(w->n)
+    for (i = 0; i < (sph__idx)w->n; ++i) {
+        const sph_real* xi = c->x + (size_t)i * (size_t)D;
+        sph_real g[3] = {0, 0, 0};
+        size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
+        int k;
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t j = c->ff->idx[kk];
+            sph_real d[3] = {0, 0, 0}, r2 = 0, q, wr, f;
+            sph__delta_vec_p(c, c->periodic_any, xi, c->x + j * (size_t)D, d, D);
+            SPH__FOR_K(D, r2 += d[k] * d[k]);
+            q = sph__sqrt(r2) * c->k.inv_h;
+            wr = sph__kw(form, q) * inv_wdx;
+            wr *= wr;
+            f = (1 + SPH__R(0.2) * wr * wr) * (c->m ? c->m[j] : c->m0) / c->rho[j] *
+                c->k.norm_g * sph__kf(form, q); /* grad W_ij = norm_g f(q) x_ij */
+            SPH__FOR_K(D, g[k] += f * d[k]);
+        }
+        if (c->has_b) {
+            k0 = c->fb->begin[i];
+            k1 = k0 + c->fb->count[i];
+            for (kk = k0; kk < k1; ++kk) {
+                const size_t b = c->fb->idx[kk];
+                sph_real d[3] = {0, 0, 0}, r2 = 0, q, wr, f;
+                sph__delta_vec_p(c, c->periodic_any, xi, c->bx + b * (size_t)D, d, D);
+                SPH__FOR_K(D, r2 += d[k] * d[k]);
+                q = sph__sqrt(r2) * c->k.inv_h;
+                wr = sph__kw(form, q) * inv_wdx;
+                wr *= wr;
+                f = (1 + SPH__R(0.2) * wr * wr) * c->bvol[b] * c->k.norm_g * sph__kf(form, q);
+                SPH__FOR_K(D, g[k] += f * d[k]);
+            }
+        }
+        SPH__FOR_K(D, sh[(size_t)i * (size_t)D + (size_t)k] = coef * g[k]);
+    }
+    SPH__OMP_FOR(w->n)
+    for (i = 0; i < (sph__idx)(w->n * (size_t)D); ++i) w->x[i] += sh[i];
+}
+
 /* Symplectic Euler (Enhanced PCISPH 2018 sec. 2.3, "semi-implicit"):
        v^{n+1}   = v^n + dt a(x^n, rho^n, v^n)
        rho^{n+1} = rho^n + dt R(x^n, v^{n+1})          R = density rate (continuity + delta-SPH)
@@ -6498,6 +6589,7 @@ static sph_status sph__step_wcsph_euler(sph_world* w, sph_real dt) {
     double t0 = sph__now(), tstart = t0;
     sph__ctx c;
     sph_status s = sph__pair_cache_reserve(w);
+    if (s == SPH_OK) s = sph__shift_reserve(w);
     if (s == SPH_OK) s = sph__prepare_forces(w, &c, w->time, &t0);
     if (s == SPH_OK && cont) s = sph__rate_cache(w, &c);
     if (s != SPH_OK) return s;
@@ -6510,6 +6602,7 @@ static sph_status sph__step_wcsph_euler(sph_world* w, sph_real dt) {
         sph__stage_interact(w, &c, SPH__RATE | SPH__CACHED, NULL);
         sph__time(w, SPH_STAGE_DENSITY, &t0);
     }
+    sph__stage_shift(w, &c, dt);
     ++w->steps;
     w->time += (double)dt;
     s = sph__integrate(w, &c, 0, cont ? dt : 0, dt, 1); /* density and drift */
@@ -6530,6 +6623,7 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
         s = sph__scratch(w, &w->priv.rho_n, w->capacity);
         if (s != SPH_OK) return s;
     }
+    if ((s = sph__shift_reserve(w)) != SPH_OK) return s;
     /* x^n, to undo the drift if the neighbour search runs out of memory (sph__undo_drift) */
     s = sph__scratch(w, &w->priv.xp, w->capacity * (size_t)w->dim);
     if (s != SPH_OK) return s;
@@ -6576,6 +6670,7 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
         for (i = 0; i < (sph__idx)w->n; ++i) w->rho[i] = w->priv.rho_n[i] + dt * w->drho[i];
         sph__time(w, SPH_STAGE_DENSITY, &t0);
     }
+    sph__stage_shift(w, &c, dt);
     ++w->steps;
     w->time += (double)dt;
     s = sph__integrate(w, &c, half, 0, half, 1); /* half kick, drift */
