@@ -497,9 +497,9 @@ int main(void) {
    No surface tension, no turbulence model, no rigid-body coupling (boundaries move kinematically),
    no adaptive resolution, no GPU. At a 1000:1 interface at rest the air is not quiet: on the
    square lattice of sph_fill_box under a background pressure the air's rows rearrange now and
-   then (up to 0.28 sqrt(g H) over 10 s, with the water under it at 0.018), and a host-placed hexagonal lattice does not fit the square wall lattice of
-   sph_add_wall_box (thrown about within 0.05 s). SPH_PGRAD_INTERFACE does not hold 1000:1 for
-   long (see PHASES).
+   then (up to 0.28 sqrt(g H) over 10 s, with the water under it at 0.018), and a host-placed
+   hexagonal lattice does not fit the square wall lattice of sph_add_wall_box (thrown about
+   within 0.05 s). SPH_PGRAD_INTERFACE does not hold 1000:1 for long (see PHASES).
 
    REFERENCES
    Comments cite these as "Author Year, eq./sec./Table N", numbered as in the work itself.
