@@ -4456,6 +4456,13 @@ SPHDEF sph_status sph_set_hydrostatic(sph_world* w) {
     for (k = 0; k < w->dim; ++k) gmag += (double)w->def.gravity[k] * (double)w->def.gravity[k];
     gmag = sqrt(gmag);
     if (!(gmag > 0)) return sph__fail(w, SPH_ERR_ARG, -1, "sph_set_hydrostatic: gravity is zero");
+    /* positions the host may have written: the columns below are integer bins of x / dx */
+    for (i = 0; i < w->n * D; ++i)
+        if (!(fabs((double)w->x[i] / (double)w->dx) < 1e15))
+            return sph__fail(w, SPH_ERR_ARG, (long)(i / D),
+                             "sph_set_hydrostatic: fluid particle %zu (id %u) has a position %g "
+                             "that is not finite or beyond 1e15 spacings; the world is unchanged",
+                             i / D, (unsigned)w->id[i / D], (double)w->x[i]);
     s = sph__resolve_sound_speed(w);
     if (s != SPH_OK) return s;
     for (k = 0; k < w->dim; ++k) up[k] = -(double)w->def.gravity[k] / gmag;
