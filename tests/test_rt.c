@@ -145,20 +145,10 @@ typedef struct rt_result {
     double approx; /* sigma / the closed approximation [-]  */
 } rt_result;
 
-static rt_result rt_run(const rt_option* o, double rho2, int across) {
-    const double g = 1, L = 1, nu = 0.01, k = 2 * RT_PI / L, rho1 = 1, dx = L / across;
-    const double a0 = 0.002 * L, A = (rho2 - rho1) / (rho2 + rho1);
-    const double se = rt_sigma_exact(k, nu, rho1, rho2, g);
-    const double sa = sqrt(A * k * g + nu * nu * k * k * k * k) - nu * k * k;
-    const double frame = 0.1 / se;
+/* The def both Rayleigh-Taylor scenes share: option o (enhanced PCISPH or WCSPH, particle
+   density, its pressure gradient), spacing dx, gravity -g in y, periodic over [0, width) in x. */
+static sph_world_def rt_def(const rt_option* o, double dx, double g, double width) {
     sph_world_def def = sph_world_def_default(2);
-    sph_world w;
-    sph_phase ph;
-    rt_result r;
-    double st = 0, sl = 0, stt = 0, stl = 0;
-    int f, nfit = 0;
-    size_t i;
-    memset(&r, 0, sizeof r);
     if (o->pcisph) sph_world_def_pcisph(&def, 1);
     def.density = SPH_DENSITY_PARTICLE;
     def.pressure_grad = o->pgrad;
@@ -166,7 +156,24 @@ static rt_result rt_run(const rt_option* o, double rho2, int across) {
     def.gravity[1] = (sph_real)-g;
     def.periodic[0] = 1;
     def.domain_lo[0] = 0;
-    def.domain_hi[0] = (sph_real)L;
+    def.domain_hi[0] = (sph_real)width;
+    return def;
+}
+
+static rt_result rt_run(const rt_option* o, double rho2, int across) {
+    const double g = 1, L = 1, nu = 0.01, k = 2 * RT_PI / L, rho1 = 1, dx = L / across;
+    const double a0 = 0.002 * L, A = (rho2 - rho1) / (rho2 + rho1);
+    const double se = rt_sigma_exact(k, nu, rho1, rho2, g);
+    const double sa = sqrt(A * k * g + nu * nu * k * k * k * k) - nu * k * k;
+    const double frame = 0.1 / se;
+    sph_world_def def = rt_def(o, dx, g, L);
+    sph_world w;
+    sph_phase ph;
+    rt_result r;
+    double st = 0, sl = 0, stt = 0, stl = 0;
+    int f, nfit = 0;
+    size_t i;
+    memset(&r, 0, sizeof r);
     if ((r.status = sph_world_init(&w, &def)) != SPH_OK) {
         TH_NOTE("%s: %s", o->name, w.error);
         return r;
@@ -379,20 +386,12 @@ static void rt_max(double* m, double e) {
 static sph_status rt_he_build(sph_world* w, const rt_option* o, double shifting, int across,
                               int verlet) {
     const double W = 1, g = 1, nu = sqrt(g * W) * W / 256, dx = W / across;
-    sph_world_def def = sph_world_def_default(2);
+    sph_world_def def = rt_def(o, dx, g, W);
     sph_phase ph;
     sph_real *pl, *ph2;
     size_t nl = 0, nh = 0;
     sph_status s;
     int i, j;
-    if (o->pcisph) sph_world_def_pcisph(&def, 1);
-    def.density = SPH_DENSITY_PARTICLE;
-    def.pressure_grad = o->pgrad;
-    def.spacing = (sph_real)dx;
-    def.gravity[1] = (sph_real)-g;
-    def.periodic[0] = 1;
-    def.domain_lo[0] = 0;
-    def.domain_hi[0] = (sph_real)W;
     def.wall = SPH_WALL_NO_SLIP;
     def.shifting = (sph_real)shifting;
     if (verlet) def.integrator = SPH_INTEGRATOR_VERLET;
