@@ -89,8 +89,10 @@ int main(void) {
    near the origin or build in double.
 
    KERNELS
-   sph_kernel_init(&k, type, dim, h) then sph_kernel_w / _dwdr / _grad. Wendland C2 (default,
-   h = 1.3 dx, 21 neighbours in 2D), cubic and quintic B-splines, Wendland C4/C6, and a Gaussian
+   sph_kernel_init(&k, type, dim, h) then sph_kernel_w / _dwdr / _grad. Wendland C2 (the world's
+   default, h = 1.3 dx, 21 neighbours in 2D; in 3D IISPH, DFSPH and PBF with zero wall pressure
+   default to the cubic B-spline at h = dx, 26 neighbours against 80: see sph_world_def.kernel),
+   cubic and quintic B-splines, Wendland C4/C6, and a Gaussian
    truncated at 3h (shifted to vanish there and renormalised, so it integrates to exactly one;
    its slope still jumps by 7e-4 of its peak at 3h). All are normalised in 1D, 2D and 3D; W and
    its derivatives are exactly zero from the support radius on. Discrete sums are not exact: on
@@ -223,7 +225,8 @@ int main(void) {
 
    SOLVER: IISPH (sph_step_iisph, or def.solver = SPH_SOLVER_IISPH)
    Implicit incompressible SPH (Ihmsen et al. 2014; Meiers 2025): summation density, then a pressure
-   that makes the predicted density the rest density, by relaxed Jacobi (def.omega = 0.5) from a
+   that makes the predicted density the rest density, by relaxed Jacobi (def.omega: 0.5, 0.3 with
+   3D Wendland C2) from a
    warm start (0.5 of the last pressure), negative pressures clamped, until the mean predicted
    compression is below def.tolerance (0.1 %) after min_iterations (2), at most max_iterations
    (100); w.stats.iterations and .solver_error report the solve. Moving walls enter the source
@@ -636,7 +639,10 @@ typedef enum sph_kernel_type {
     SPH_KERNEL_WENDLAND_C4,     /* Wendland C4, support 2h                                        */
     SPH_KERNEL_WENDLAND_C6,     /* Wendland C6, support 2h                                        */
     SPH_KERNEL_GAUSSIAN,        /* Gaussian truncated at 3h, shifted to vanish there, renormalised */
-    SPH_KERNEL_COUNT
+    SPH_KERNEL_COUNT,
+    SPH_KERNEL_AUTO = -1        /* sph_world_def only (its default): resolved by sph_world_init
+                                   from the dimension, solver and wall scheme (see
+                                   sph_world_def.kernel); not a kernel of its own               */
 } sph_kernel_type;
 
 /* A kernel bound to a dimension and smoothing length. Plain data: copy it freely. Set up with
@@ -992,7 +998,15 @@ typedef struct sph_world_def {
     sph_real h_factor;         /* h = h_factor * dx [-]; 0 (default) = kernel's recommended value
                                   (sph_kernel_default_h_factor); 0 or (0, 100]. w.def holds the
                                   value used                                                     */
-    sph_kernel_type kernel;    /* default SPH_KERNEL_WENDLAND_C2                                  */
+    sph_kernel_type kernel;    /* default SPH_KERNEL_AUTO: sph_world_init takes the cubic B-spline
+                                  at h = dx (h_factor 0) in 3D for IISPH, DFSPH and PBF with zero
+                                  wall pressure, else Wendland C2 (h = 1.3 dx). Measured on the 3D
+                                  dam break and tank (README, "The kernel in 3D"): the cubic's 33
+                                  neighbours against Wendland's 74 take those solvers through a
+                                  simulated second in about half the time at the same compression,
+                                  and their tank at rest is quieter; WCSPH's hydrostatic pressure
+                                  and extrapolated walls are worse with it. w.def holds the
+                                  kernel used                                                    */
     sph_real gravity[3];       /* [m/s^2]; default (0, -9.81, 0) in 2D/3D (y is up), 0 in 1D;
                                   finite; components beyond dim are ignored                      */
     sph_solver solver;         /* used by sph_step / sph_advance (and sph_set_hydrostatic);
@@ -1045,7 +1059,10 @@ typedef struct sph_world_def {
                                   reaches it above its tolerance takes the step with its last
                                   pressure and returns SPH_ERR_NOT_CONVERGED (sph_advance then
                                   undoes the step and retries a smaller one)                     */
-    sph_real omega;            /* IISPH's relaxed Jacobi weight [-]; default 0.5; (0, 1]          */
+    sph_real omega;            /* IISPH's and DFSPH's relaxed Jacobi weight [-]; 0 or (0, 1];
+                                  0 (default): 0.5, or 0.3 where a full lattice has more than 50
+                                  neighbours (3D Wendland C2: see sph_world_def_default). w.def
+                                  holds the value used                                           */
     sph_pressure_solve pressure_solve; /* IISPH: SPH_PSOLVE_JACOBI (default) or SPH_PSOLVE_CG (zero
                                   wall pressure only; Jacobi with the other schemes); max_iterations
                                   then counts products with A                                    */
@@ -1286,6 +1303,8 @@ typedef struct sph__private {
     sph_real lattice_grad;          /* the gradient's first moment on that lattice, see
                                        sph__lattice_grad                                         */
     size_t full_count;              /* neighbours of a particle inside a full square lattice      */
+    sph_real contact_short, contact_full; /* the wall contact's ramp, fractions of full_count
+                                       (sph__contact_ramp)                                       */
     sph_real wall_fraction_max;     /* check_walls: wall volume fraction of a particle on the
                                        first layer of a flat lattice wall                          */
     uint8_t* snap[2];               /* sph_advance: the state at the call's start [0] and at the
@@ -2944,7 +2963,7 @@ SPHDEF sph_world_def sph_world_def_default(int dim) {
     d.dim = dim;
     d.spacing = SPH__R(0.01);
     d.h_factor = 0;
-    d.kernel = SPH_KERNEL_WENDLAND_C2;
+    d.kernel = SPH_KERNEL_AUTO;
     if (dim >= 2) d.gravity[1] = SPH__R(-9.81);
     d.solver = SPH_SOLVER_WCSPH;
     d.density = SPH_DENSITY_CONTINUITY;
@@ -2975,10 +2994,11 @@ SPHDEF sph_world_def sph_world_def_default(int dim) {
     d.tolerance = SPH__R(0.001);  /* 0.1 % mean compression, Meiers 2025 */
     d.min_iterations = 2;
     d.max_iterations = 100;
-    /* Ihmsen et al. 2014, Meiers 2025: 0.5. Relaxed Jacobi converges while omega lambda_max < 2,
-       lambda_max of D^-1 A: 2.6 on a 2D lattice, 4.1 on a 3D one and 5.4-5.7 once it disorders
-       (Wendland C2, h = 1.3 dx: 21 neighbours in 2D, 73 in 3D), so 3D gets 0.3 */
-    d.omega = dim == 3 ? SPH__R(0.3) : SPH__R(0.5);
+    /* automatic (sph_world_init, sph__auto_omega): Ihmsen et al. 2014, Meiers 2025: 0.5.
+       Relaxed Jacobi converges while omega lambda_max < 2, lambda_max of D^-1 A: 2.6 on a 2D
+       lattice, 4.1 on a 3D one and 5.4-5.7 once it disorders (Wendland C2, h = 1.3 dx: 21
+       neighbours in 2D, 73 in 3D), so a kernel with that many neighbours gets 0.3 */
+    d.omega = 0;
     d.pressure_solve = SPH_PSOLVE_JACOBI;
     d.warm_start = SPH__R(0.5);   /* Ihmsen et al. 2014 */
     d.tolerance_max = 0;
@@ -3081,7 +3101,7 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
     SPH__CHECK(sph__finite((double)d->h_factor) && d->h_factor >= 0 && d->h_factor <= 100,
                "sph_world_def.h_factor = %g: must be 0 (kernel default) or in (0, 100]",
                (double)d->h_factor);
-    SPH__CHECK((int)d->kernel >= 0 && d->kernel < SPH_KERNEL_COUNT,
+    SPH__CHECK(d->kernel == SPH_KERNEL_AUTO || ((int)d->kernel >= 0 && d->kernel < SPH_KERNEL_COUNT),
                "sph_world_def.kernel = %d: not a sph_kernel_type", (int)d->kernel);
     for (k = 0; k < 3; ++k)
         SPH__CHECK(sph__finite((double)d->gravity[k]), "sph_world_def.gravity[%d] = %g: not finite",
@@ -3111,8 +3131,8 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
                    d->max_iterations >= d->min_iterations,
                "sph_world_def.max_iterations = %d: must be in [max(1, min_iterations), 100000]",
                d->max_iterations);
-    SPH__CHECK(sph__finite((double)d->omega) && d->omega > 0 && d->omega <= 1,
-               "sph_world_def.omega = %g: must be in (0, 1]", (double)d->omega);
+    SPH__CHECK(sph__finite((double)d->omega) && d->omega >= 0 && d->omega <= 1,
+               "sph_world_def.omega = %g: must be 0 (automatic) or in (0, 1]", (double)d->omega);
     SPH__CHECK((int)d->pressure_solve >= 0 && d->pressure_solve <= SPH_PSOLVE_CG,
                "sph_world_def.pressure_solve = %d: not a sph_pressure_solve", (int)d->pressure_solve);
     SPH__CHECK(sph__finite((double)d->warm_start) && d->warm_start >= 0 && d->warm_start <= 1,
@@ -3307,6 +3327,44 @@ static sph_real sph__akinci_gamma(const sph_kernel* k, sph_real dx) {
     return wall > 0 ? (sph_real)((full - half) * line / (full * wall)) : 1;
 }
 
+/* The wall contact's ramp in 3D (sph__wall_contact), from two neighbour counts on the lattice
+   of the world's kernel, as fractions of a full neighbourhood (full_count): a one-particle sheet
+   over the hollows of a single wall layer, 0.5 dx above it (what the contact is for: "short" is
+   0.15 above its count), and a surface particle of a resting fluid beside a wall of ceil(R)
+   layers, 0.6 dx from the first ("full" is 0.04 above its count, so such a particle rests at
+   contact 0.68 dx and a particle with fluid on all sides at 0.6 dx). Wendland C2 at h = 1.3 dx
+   (support R = 2.6 dx, 80 lattice neighbours): sheet 0.55, surface particle 0.81, so the ramp
+   runs from 0.70 to 0.85, the thresholds measured for it on the 3D tank at rest (see
+   sph__wall_contact); the cubic B-spline at h = dx (R = 2 dx, 26): 0.77 and 0.96, a ramp from
+   0.85 to 1.0 (fixed fractions 0.7 and 0.85 let its sheet sink 0.19 dx past the face). */
+static void sph__contact_ramp(sph_world* w) {
+    const double R = (double)(w->kernel.radius / w->dx), R2 = R * R;
+    const int M = (int)R + 2, L = (int)ceil(R);
+    double sheet = 0, top = 0, full = (double)w->priv.full_count;
+    int i, j, k;
+    for (i = -M; i <= M; ++i)
+        for (k = -M; k <= M; ++k) {
+            /* the sheet particle at (0.5, 0.5, 0.5): its sheet and the layer at y = 0 */
+            double d2 = (double)(i * i + k * k);
+            if (d2 > 0 && d2 < R2) sheet += 1;
+            d2 = (i - 0.5) * (i - 0.5) + 0.25 + (k - 0.5) * (k - 0.5);
+            if (d2 < R2) sheet += 1;
+            /* the surface particle at (0.1, 0, 0): fluid at x >= 0.1, y <= 0; wall at x <= -0.5 */
+            for (j = 0; j <= M; ++j) {
+                d2 = (double)(i * i + j * j + k * k);
+                if (i >= 0 && d2 > 0 && d2 < R2) top += 1;
+            }
+            if (i < L) /* i is the wall layer here, k along it, j up and down */
+                for (j = -M; j <= M; ++j) {
+                    d2 = (0.6 + i) * (0.6 + i) + (double)(j * j + k * k);
+                    if (i >= 0 && d2 < R2) top += 1;
+                }
+        }
+    if (!(full > 0)) full = 1;
+    w->priv.contact_full = (sph_real)(top / full + 0.04);
+    w->priv.contact_short = (sph_real)fmin(sheet / full + 0.15, top / full + 0.04 - 0.15);
+}
+
 SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
     sph_status s;
     sph_real hf, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
@@ -3326,15 +3384,25 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
     w->dim = def->dim;
     w->dx = def->spacing;
     w->priv.solver = (int)def->solver; /* until a step says which solver runs */
-    hf = def->h_factor > 0 ? def->h_factor : sph_kernel_default_h_factor(def->kernel);
-    w->def.h_factor = hf;
     if (def->boundary_pressure == SPH_BP_AUTO)
         w->def.boundary_pressure = def->solver == SPH_SOLVER_IISPH || def->solver == SPH_SOLVER_DFSPH ||
                                            def->solver == SPH_SOLVER_PBF
                                        ? SPH_BP_ZERO
                                        : SPH_BP_EXTRAPOLATE;
+    /* the automatic kernel (sph_world_def.kernel): the cubic B-spline at h = dx, SPlisHSPlasH's
+       support of 2 dx, where it was measured better (README, "The kernel in 3D") */
+    if (def->kernel == SPH_KERNEL_AUTO) {
+        const int cubic = def->dim == 3 && w->def.boundary_pressure == SPH_BP_ZERO &&
+                          (def->solver == SPH_SOLVER_IISPH || def->solver == SPH_SOLVER_DFSPH ||
+                           def->solver == SPH_SOLVER_PBF);
+        w->def.kernel = cubic ? SPH_KERNEL_CUBIC : SPH_KERNEL_WENDLAND_C2;
+        hf = def->h_factor > 0 ? def->h_factor : cubic ? 1 : sph_kernel_default_h_factor(w->def.kernel);
+    } else {
+        hf = def->h_factor > 0 ? def->h_factor : sph_kernel_default_h_factor(def->kernel);
+    }
+    w->def.h_factor = hf;
     w->h = hf * def->spacing;
-    s = sph_kernel_init(&w->kernel, def->kernel, def->dim, w->h);
+    s = sph_kernel_init(&w->kernel, w->def.kernel, def->dim, w->h);
     if (s != SPH_OK) /* the type and dim are valid: h is out of sph_real's reach */
         return sph__fail(w, s, -1,
                          "sph_world_def.spacing = %g: h = %g m gives kernel constants that are "
@@ -3354,6 +3422,11 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
                         w->dx * sph__sqrt((sph_real)(i * i + j * j + l * l)) < w->kernel.radius)
                         ++w->priv.full_count;
     }
+    sph__contact_ramp(w);
+    /* the automatic Jacobi weight (sph_world_def.omega): lambda_max of D^-1 A grows with the
+       neighbourhood (2.6 with 20 neighbours, 5.4-5.7 with 72 once disordered), and relaxed
+       Jacobi needs omega lambda_max < 2 */
+    if (def->omega == 0) w->def.omega = w->priv.full_count > 50 ? SPH__R(0.3) : SPH__R(0.5);
     for (k = 0; k < def->dim; ++k) {
         per[k] = def->periodic[k] != 0;
         lo[k] = def->domain_lo[k];
@@ -5741,13 +5814,13 @@ static sph_real sph__wall_fraction(const sph__ctx* c, const sph_real* xi, size_t
    d_c plus the step's displacement (at most max_displacement dx, checked next). Returns whether
    the particle moved.
    In 3D with zero wall pressure and an incompressible solver d_c is for particles short of
-   neighbours: one whose fluid and wall neighbours number at least SPH__CONTACT_FULL of a full
-   lattice neighbourhood (the measure sph__enclosed uses) has the wall supply only what a fluid
+   neighbours: one whose fluid and wall neighbours number at least a fraction "full" of a full
+   lattice neighbourhood (0.85 for Wendland C2 at h = 1.3 dx, see sph__contact_ramp) (the measure sph__enclosed uses) has the wall supply only what a fluid
    would, so the pressure solve, which holds its density, holds it, and its contact distance is
    SPH__CONTACT_REST dx (over a wall particle its centre stays 0.1 dx on the fluid side of the
    wall's face; over the hollow between wall particles it is free to reach the face, where zero
    wall pressure's resting rows sit, +-0.04 dx); the distance grows linearly to d_c as the count
-   falls to SPH__CONTACT_SHORT of a full set (a switch instead
+   falls to a fraction "short" (0.7) of a full set (a switch instead
    of the ramp moved a particle 0.4 dx in one step whenever its count crossed the line, and its
    neighbours answered at 0.1-0.14 sqrt(g H)). Why: zero wall pressure's resting state is not the
    lattice. The wall pushes with p_i alone, so the rows at a wall settle up to 0.35 dx closer to
@@ -5764,8 +5837,6 @@ static sph_real sph__wall_fraction(const sph__ctx* c, const sph_real* xi, size_t
    hold the fluid at the lattice's 1 dx, where d_c touches nothing, and WCSPH's equation of state
    holds no density (with zero wall pressure its floor row went through without the contact,
    tests/test_wcsph.c): there d_c applies to every particle. */
-#define SPH__CONTACT_FULL 0.85
-#define SPH__CONTACT_SHORT 0.7
 #define SPH__CONTACT_REST 0.6
 /* The wall's normal at x, n = -sum_b V_b grad W(x - x_b) (unnormalised: the wall volume
    fraction's descent, pointing away from the wall's mass), over fluid particle i's wall list. */
@@ -6008,8 +6079,8 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 if (ramp) { /* from d_c short of neighbours down to 0.6 dx with a full set */
                     const sph_real d0 = SPH__R(SPH__CONTACT_REST) * w->dx;
                     const sph_real nf = (sph_real)(c->ff->count[i] + c->fb->count[i]) * inv_full;
-                    sph_real f = (SPH__R(SPH__CONTACT_FULL) - nf) *
-                                 SPH__R(1 / (SPH__CONTACT_FULL - SPH__CONTACT_SHORT));
+                    sph_real f = (w->priv.contact_full - nf) /
+                                 (w->priv.contact_full - w->priv.contact_short);
                     f = f < 0 ? 0 : f > 1 ? 1 : f;
                     d = d0 + f * (dc > d0 ? dc - d0 : 0);
                 }
@@ -6346,7 +6417,7 @@ static sph_status sph__reserve_blocks(sph_world* w) {
 /* w.def as a step finds it: a host may change the tunable fields between steps (tolerances,
    limits, callbacks, the solver), within their ranges; the fields the world was built from (dim,
    spacing, kernel, h_factor, periodic directions and their box) and the ones sph_world_init
-   resolved (boundary_pressure and boundary_gamma, see there) must stay. A bad value fails the
+   resolved (boundary_pressure, boundary_gamma and an automatic omega, see there) must stay. A bad value fails the
    step with SPH_ERR_ARG naming the field, before anything changed. */
 static sph_status sph__check_def_now(sph_world* w) {
     const sph_world_def* d = &w->def;
@@ -6368,6 +6439,10 @@ static sph_status sph__check_def_now(sph_world* w) {
                          "after sph_world_init, which resolves them; set a scheme (SPH_BP_ZERO, "
                          "SPH_BP_EXTRAPOLATE) and a gamma > 0",
                          (double)d->boundary_gamma);
+    if (!(d->omega > 0))
+        return sph__fail(w, SPH_ERR_ARG, -1,
+                         "step: w.def.omega = 0 (automatic) set after sph_world_init, which "
+                         "resolves it; set a weight in (0, 1]");
     if (sph__validate_def(w, d) != SPH_OK) {
         char msg[SPH_ERROR_SIZE];
         memcpy(msg, w->error, sizeof msg);
@@ -7994,7 +8069,8 @@ SPHDEF sph_status sph_step_iisph(sph_world* w, sph_real dt) {
    unrelaxed update (omega = 1) diverges on the shortest waves (a 2D tank blows up in its first
    step), and one-sided increments (compression only, pressures never lowered within a step)
    ratchet: with a full warm start the pressures only grow, with half of it each step rebuilds
-   half the hydrostatic pressure; so the update is relaxed by def.omega (0.5; 3D tanks need 0.3)
+   half the hydrostatic pressure; so the update is relaxed by def.omega (0.5; 3D tanks with
+   Wendland C2's 80 neighbours need 0.3)
    and warm started with def.warm_start (0.5), as IISPH's. Per iteration a solve costs one
    pressure pass and one cached continuity pass, as an IISPH iteration does.
    Boundary schemes: ZERO (p_b = 0, k_b = 0) is Akinci et al.'s boundary as Bender & Koschier use

@@ -425,6 +425,8 @@ BENCH_FN int BX(tts_build)(sph_world* w, int scene, int solver, int quick) {
         def.kernel = SPH_KERNEL_CUBIC;
         def.h_factor = 1;
         def.omega = (sph_real)0.5;
+    } else if (bench_tts_kernel == 2) { /* --kernel wendland: Wendland C2 at h = 1.3 dx */
+        def.kernel = SPH_KERNEL_WENDLAND_C2;
     }
     if (scene == TTS_DAM2D) { /* examples/dambreak.c's scene: a = 0.5 m, 40 particles per a */
         const double a = 0.5;

@@ -58,7 +58,6 @@ static df_tank run_df_tank(sph_solver solver, int dim, sph_boundary_pressure bp,
     memset(&r, 0, sizeof(r));
     def.solver = solver;
     def.boundary_pressure = bp;
-    if (dim == 3) def.omega = (sph_real)0.3; /* see test_df_tank_3d */
     def.domain_lo[0] = def.domain_lo[1] = def.domain_lo[2] = (sph_real)(-0.5 * H / res);
     def.domain_hi[0] = def.domain_hi[2] = (sph_real)(W + 0.5 * H / res);
     def.domain_hi[1] = 10;
@@ -169,10 +168,11 @@ static void test_df_tank_2d(void) {
 }
 
 /* 3D tank 0.2 m wide and deep (10 particles) for 1.5 s at 5.1 ms, extrapolated walls: the same
-   checks. With def.omega = 0.5 (the default) both DFSPH and IISPH blow up on this tank within
-   0.05 s (measured: the relaxed Jacobi diverges; in 3D a particle has about 2.5 times the
-   neighbours of 2D), so the tank runs at omega = 0.3. Zero-pressure walls are reported: they
-   hold the fluid, but their interior layers are 5 % off hydrostatic. */
+   checks. With def.omega = 0.5 both DFSPH and IISPH blew up on this tank within 0.05 s with
+   Wendland C2 (measured: the relaxed Jacobi diverges; in 3D a particle has about 4 times the
+   neighbours of 2D), so the automatic weight is 0.3 for that kernel (extrapolated walls keep it);
+   zero-pressure walls get the cubic at h = dx and 0.5. Zero-pressure walls are reported: they
+   hold the fluid, but their interior layers are off hydrostatic. */
 static void test_df_tank_3d(void) {
     df_tank r = run_df_tank(SPH_SOLVER_DFSPH, 3, SPH_BP_EXTRAPOLATE, 0.2, 0.2, 10, 1.5);
     df_check_tank("DFSPH 3D tank, extrapolation", &r, 0.2, 0.02, 0.02);
