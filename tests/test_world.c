@@ -592,61 +592,145 @@ static void test_advance_stable_step(void) {
    gamma = 1 overweighs less: 6 % against 15 %). */
 static void test_akinci_gamma(void) {
     int dim, g, kern;
-    for (kern = 0; kern < 2; ++kern)
-    for (dim = 2; dim <= 3; ++dim)
-        for (g = 0; g < 2; ++g) {
-            sph_world_def d = sph_world_def_default(dim);
-            sph_world w;
-            sph_phase water;
-            const double dx = 0.05;
-            const int n = 12; /* lattice points per side */
-            sph_real lo[3] = {0, 0, 0}, hi[3], *xb;
-            size_t i, nb = 0, cnt = 0;
-            int a, b;
-            double rho = 0;
-            memset(&water, 0, sizeof water);
-            water.rest_density = 1000;
-            d.spacing = (sph_real)dx;
-            d.solver = SPH_SOLVER_IISPH;
-            d.gravity[1] = 0;
-            d.boundary_volume = SPH_BVOL_AKINCI;
-            if (kern == 0) d.kernel = SPH_KERNEL_WENDLAND_C2;
-            if (g) d.boundary_gamma = 1;
-            for (a = 0; a < 3; ++a) hi[a] = (sph_real)(n * dx);
-            CHECK_EQ_INT(sph_world_init(&w, &d), SPH_OK);
-            if (!g && kern == 0) CHECK_NEAR(w.def.boundary_gamma, dim == 2 ? 0.5846 : 0.5872, 5e-4);
-            CHECK(sph_world_add_phase(&w, &water) == 0);
-            CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
-            /* one layer at y = -0.5 dx under the block, wider than it by the kernel's reach */
-            xb = (sph_real*)malloc(sizeof(sph_real) * 3 * (size_t)((n + 8) * (n + 8)));
-            for (a = -4; a < n + 4; ++a)
-                for (b = (dim == 3 ? -4 : 0); b < (dim == 3 ? n + 4 : 1); ++b) {
-                    xb[nb * (size_t)dim] = (sph_real)((a + 0.5) * dx);
-                    xb[nb * (size_t)dim + 1] = (sph_real)(-0.5 * dx);
-                    if (dim == 3) xb[nb * (size_t)dim + 2] = (sph_real)((b + 0.5) * dx);
-                    ++nb;
+    for (kern = 0; kern < 2; ++kern) { /* Wendland C2; the automatic kernel (only 3D differs) */
+        for (dim = 2 + kern; dim <= 3; ++dim)
+            for (g = 0; g < 2; ++g) {
+                sph_world_def d = sph_world_def_default(dim);
+                sph_world w;
+                sph_phase water;
+                const double dx = 0.05;
+                const int n = 12; /* lattice points per side */
+                sph_real lo[3] = {0, 0, 0}, hi[3], *xb;
+                size_t i, nb = 0, cnt = 0;
+                int a, b;
+                double rho = 0;
+                memset(&water, 0, sizeof water);
+                water.rest_density = 1000;
+                d.spacing = (sph_real)dx;
+                d.solver = SPH_SOLVER_IISPH;
+                d.gravity[1] = 0;
+                d.boundary_volume = SPH_BVOL_AKINCI;
+                if (kern == 0) d.kernel = SPH_KERNEL_WENDLAND_C2;
+                if (g) d.boundary_gamma = 1;
+                for (a = 0; a < 3; ++a) hi[a] = (sph_real)(n * dx);
+                CHECK_EQ_INT(sph_world_init(&w, &d), SPH_OK);
+                if (!g && kern == 0) CHECK_NEAR(w.def.boundary_gamma, dim == 2 ? 0.5846 : 0.5872, 5e-4);
+                CHECK(sph_world_add_phase(&w, &water) == 0);
+                CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
+                /* one layer at y = -0.5 dx under the block, wider than it by the kernel's reach */
+                xb = (sph_real*)malloc(sizeof(sph_real) * 3 * (size_t)((n + 8) * (n + 8)));
+                for (a = -4; a < n + 4; ++a)
+                    for (b = (dim == 3 ? -4 : 0); b < (dim == 3 ? n + 4 : 1); ++b) {
+                        xb[nb * (size_t)dim] = (sph_real)((a + 0.5) * dx);
+                        xb[nb * (size_t)dim + 1] = (sph_real)(-0.5 * dx);
+                        if (dim == 3) xb[nb * (size_t)dim + 2] = (sph_real)((b + 0.5) * dx);
+                        ++nb;
+                    }
+                CHECK_EQ_INT(sph_add_boundary(&w, nb, xb, NULL, 0), SPH_OK);
+                free(xb);
+                CHECK_EQ_INT(th_step(&w, (sph_real)1e-9), SPH_OK);
+                /* the first row, away from the block's side faces */
+                for (i = 0; i < w.n; ++i) {
+                    const sph_real* x = w.x + i * (size_t)dim;
+                    if (x[1] < dx && x[0] > 3 * dx && x[0] < (n - 3) * dx &&
+                        (dim == 2 || (x[2] > 3 * dx && x[2] < (n - 3) * dx))) {
+                        rho += (double)w.rho[i];
+                        ++cnt;
+                    }
                 }
-            CHECK_EQ_INT(sph_add_boundary(&w, nb, xb, NULL, 0), SPH_OK);
-            free(xb);
-            CHECK_EQ_INT(th_step(&w, (sph_real)1e-9), SPH_OK);
-            /* the first row, away from the block's side faces */
-            for (i = 0; i < w.n; ++i) {
-                const sph_real* x = w.x + i * (size_t)dim;
-                if (x[1] < dx && x[0] > 3 * dx && x[0] < (n - 3) * dx &&
-                    (dim == 2 || (x[2] > 3 * dx && x[2] < (n - 3) * dx))) {
-                    rho += (double)w.rho[i];
-                    ++cnt;
-                }
+                CHECK(cnt > 0);
+                rho /= (double)(cnt ? cnt : 1);
+                TH_NOTE("%dD, %s, gamma %.4f: first row beside a single Akinci layer at rho/rho0 = %.5f",
+                        dim, sph_kernel_name(w.def.kernel), (double)w.def.boundary_gamma, rho / 1000);
+                if (!g) CHECK_NEAR(rho / 1000, 1, 1e-3);
+                else /* gamma = 1: the layer weighs too much */
+                    CHECK_LT(w.def.kernel == SPH_KERNEL_WENDLAND_C2 ? 1.1 : 1.05, rho / 1000);
+                sph_world_free(&w);
             }
-            CHECK(cnt > 0);
-            rho /= (double)(cnt ? cnt : 1);
-            TH_NOTE("%dD, %s, gamma %.4f: first row beside a single Akinci layer at rho/rho0 = %.5f",
-                    dim, sph_kernel_name(w.def.kernel), (double)w.def.boundary_gamma, rho / 1000);
-            if (!g) CHECK_NEAR(rho / 1000, 1, 1e-3);
-            else /* gamma = 1: the layer weighs too much */
-                CHECK_LT(w.def.kernel == SPH_KERNEL_WENDLAND_C2 ? 1.1 : 1.05, rho / 1000);
-            sph_world_free(&w);
-        }
+    }
+}
+
+/* The automatic kernel and Jacobi weight (def.kernel = SPH_KERNEL_AUTO, def.omega = 0, the
+   defaults): sph_world_init resolves them into w.def from the dimension, solver and wall scheme
+   (the cubic B-spline at h = dx for 3D IISPH, DFSPH and PBF with zero wall pressure, Wendland C2
+   at h = 1.3 dx otherwise; 0.3 where a lattice has more than 50 neighbours, else 0.5), keeps
+   what the host chose, and a step refuses an automatic value set after init, leaving the world
+   as it was. */
+static void test_auto_kernel(void) {
+    static const struct {
+        int dim;
+        sph_solver solver;
+        int bp; /* -1: automatic */
+        sph_kernel_type kernel;
+        double h_factor, omega;
+    } cases[] = {
+        {3, SPH_SOLVER_IISPH, -1, SPH_KERNEL_CUBIC, 1.0, 0.5},
+        {3, SPH_SOLVER_DFSPH, -1, SPH_KERNEL_CUBIC, 1.0, 0.5},
+        {3, SPH_SOLVER_PBF, -1, SPH_KERNEL_CUBIC, 1.0, 0.5},
+        {3, SPH_SOLVER_IISPH, SPH_BP_EXTRAPOLATE, SPH_KERNEL_WENDLAND_C2, 1.3, 0.3},
+        {3, SPH_SOLVER_WCSPH, -1, SPH_KERNEL_WENDLAND_C2, 1.3, 0.3},
+        {3, SPH_SOLVER_PCISPH, -1, SPH_KERNEL_WENDLAND_C2, 1.3, 0.3},
+        {3, SPH_SOLVER_COMPRESSIBLE, -1, SPH_KERNEL_WENDLAND_C2, 1.3, 0.3},
+        {2, SPH_SOLVER_IISPH, -1, SPH_KERNEL_WENDLAND_C2, 1.3, 0.5},
+        {2, SPH_SOLVER_DFSPH, -1, SPH_KERNEL_WENDLAND_C2, 1.3, 0.5},
+        {1, SPH_SOLVER_WCSPH, -1, SPH_KERNEL_WENDLAND_C2, 1.3, 0.5},
+    };
+    size_t c;
+    for (c = 0; c < sizeof cases / sizeof cases[0]; ++c) {
+        sph_world_def d = sph_world_def_default(cases[c].dim);
+        sph_world w;
+        CHECK_EQ_INT(d.kernel, SPH_KERNEL_AUTO);
+        CHECK(d.omega == 0);
+        d.solver = cases[c].solver;
+        if (cases[c].bp >= 0) d.boundary_pressure = (sph_boundary_pressure)cases[c].bp;
+        CHECK_EQ_INT(sph_world_init(&w, &d), SPH_OK);
+        CHECK_MSG(w.def.kernel == cases[c].kernel && w.kernel.type == cases[c].kernel,
+                  "case %zu: kernel %s", c, sph_kernel_name(w.def.kernel));
+        CHECK_NEAR(w.def.h_factor, cases[c].h_factor, 1e-6);
+        CHECK_NEAR(w.h, cases[c].h_factor * (double)d.spacing, 1e-9);
+        CHECK_NEAR(w.def.omega, cases[c].omega, 1e-6);
+        sph_world_free(&w);
+    }
+    { /* the host's choice is kept */
+        sph_world_def d = sph_world_def_default(3);
+        sph_world w;
+        d.solver = SPH_SOLVER_IISPH;
+        d.kernel = SPH_KERNEL_WENDLAND_C2;
+        d.omega = (sph_real)0.4;
+        CHECK_EQ_INT(sph_world_init(&w, &d), SPH_OK);
+        CHECK_EQ_INT(w.def.kernel, SPH_KERNEL_WENDLAND_C2);
+        CHECK_NEAR(w.def.h_factor, 1.3, 1e-6);
+        CHECK_NEAR(w.def.omega, 0.4, 1e-6);
+        sph_world_free(&w);
+        d.kernel = SPH_KERNEL_CUBIC; /* chosen by the host: the kernel's own h factor */
+        CHECK_EQ_INT(sph_world_init(&w, &d), SPH_OK);
+        CHECK_NEAR(w.def.h_factor, (double)sph_kernel_default_h_factor(SPH_KERNEL_CUBIC), 1e-6);
+        sph_world_free(&w);
+    }
+    { /* automatic values set after init: refused by the step, nothing changed */
+        sph_world_def d = sph_world_def_default(3);
+        sph_world w;
+        const sph_real lo[3] = {0, 0, 0}, hi[3] = {0.1f, 0.1f, 0.1f};
+        double t0;
+        d.solver = SPH_SOLVER_IISPH;
+        d.spacing = (sph_real)0.02;
+        CHECK_EQ_INT(sph_world_init(&w, &d), SPH_OK);
+        CHECK(sph_world_add_phase(&w, &(sph_phase){.rest_density = 1000}) == 0);
+        CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
+        CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 0, 0), SPH_OK);
+        t0 = w.time;
+        w.def.omega = 0;
+        CHECK_EQ_INT(sph_step(&w, (sph_real)1e-3), SPH_ERR_ARG);
+        CHECK_MSG(strstr(w.error, "omega") != NULL, "message '%s' lacks omega", w.error);
+        CHECK(w.time == t0);
+        w.def.omega = (sph_real)0.5;
+        w.def.kernel = SPH_KERNEL_AUTO;
+        CHECK_EQ_INT(sph_step(&w, (sph_real)1e-3), SPH_ERR_ARG);
+        CHECK_MSG(strstr(w.error, "kernel") != NULL, "message '%s' lacks kernel", w.error);
+        w.def.kernel = SPH_KERNEL_CUBIC;
+        CHECK_EQ_INT(th_step(&w, (sph_real)1e-3), SPH_OK);
+        sph_world_free(&w);
+    }
 }
 
 const th_test tests_world[] = {
@@ -663,5 +747,6 @@ const th_test tests_world[] = {
     {"world/write_csv_vtk", test_write_csv_vtk},
     {"world/advance_by_the_stable_step_is_one_step", test_advance_stable_step},
     {"world/akinci_gamma_gives_rest_density", test_akinci_gamma},
+    {"world/automatic_kernel_and_omega", test_auto_kernel},
     {0, 0},
 };
