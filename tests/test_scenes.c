@@ -429,16 +429,17 @@ static void test_box_2d_long(void) { sc_defaults(SC_BOX, 2, 0.02, 1.0); }
 static void test_tank_3d_long(void) { sc_defaults(SC_TANK, 3, 0.025, 1.0); }
 static void test_dam_3d_long(void) { sc_defaults(SC_DAM, 3, 0.025, 1.0); }
 /* A 3D tank at rest comes to rest (make validate): the incompressible solvers with their default
-   walls (zero wall pressure), 4 s. Zero wall pressure settles its floor rows up to 0.35 dx
-   closer to the wall than the lattice sph_set_hydrostatic starts from; while the wall contact
-   fought that (it moved about 200 of the 800 particles each step, see sph__wall_contact), the
-   tank kept moving at 0.19-0.25 sqrt(g H) for good. Left to the pressure (the contact shrinks to
-   dx/2 for particles with a full neighbourhood) it settles: measured over the last half second
-   0.043 (IISPH), 0.041 (DFSPH) and 0.054 (enhanced PCISPH, extrapolated walls) sqrt(g H), the
-   kinetic energy falling from about 0.28 J at 0.5 s to 0.004 J at 4 s. Asserted: below 0.08
-   sqrt(g H) late and no particle through a wall. The issue's target is 0.01; what remains is
-   the pressure solves' noise at their 0.1 % tolerance (a 2D tank at 0.01 % settles to 0.002 by
-   8 s with DFSPH) and the slow rearrangement of the rows at the walls. */
+   walls (zero wall pressure; enhanced PCISPH extrapolated), 10 s, the largest speed over the
+   last half second. Zero wall pressure settles its floor rows up to 0.35 dx closer to the wall
+   than the lattice sph_set_hydrostatic starts from; while the wall contact fought that (it moved
+   about 200 of the 800 particles each step, see sph__wall_contact), the tank kept moving at
+   0.19-0.25 sqrt(g H) for good. Left to the pressure (the contact shrinks for particles with a
+   full neighbourhood) it settles. Measured after 4 s with Wendland C2: 0.043 (IISPH), 0.041
+   (DFSPH), 0.054 (enhanced PCISPH) sqrt(g H), and IISPH still 0.042 after 10 s, kept up by a few
+   surface particles at the side walls (p = 0: the wall, which pushes with p_i alone, does not
+   push them, the fluid behind them does). With the automatic 3D kernel (the cubic at h = dx)
+   after 10 s: IISPH 0.0084, DFSPH 0.028, enhanced PCISPH (still Wendland C2) 0.0125. Asserted:
+   IISPH below the issue's 0.01, the others below 0.04, no particle through a wall. */
 static void test_tank_3d_settles(void) {
     int si;
     for (si = 0; si < (int)(sizeof sc_solvers / sizeof sc_solvers[0]); ++si) {
@@ -446,10 +447,10 @@ static void test_tank_3d_settles(void) {
         sc_result r;
         if (so->solver != SPH_SOLVER_IISPH && so->solver != SPH_SOLVER_DFSPH && so->pcisph != 1)
             continue;
-        r = sc_run(SC_TANK, so, -1, 3, 0.04, 4.0);
+        r = sc_run(SC_TANK, so, -1, 3, 0.04, 10.0);
         CHECK_MSG(r.status == SPH_OK, "%s: failed at t = %.2f s", so->name, r.t_end);
         CHECK_EQ_INT(r.escaped, 0);
-        CHECK_LE(r.v_late / r.v_ref, 0.08);
+        CHECK_LE(r.v_late / r.v_ref, so->solver == SPH_SOLVER_IISPH ? 0.01 : 0.04);
     }
 }
 
