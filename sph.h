@@ -7922,6 +7922,7 @@ static sph_status sph__iisph_cg(sph_world* w, const sph__ctx* c, sph_real dt, in
 static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
     double t0 = sph__now(), tstart = t0, err = 0, errmax = 0, err_min[2] = {0, 0};
+    size_t worst = 0; /* the most compressed particle of a solve that ends beyond the bound */
     sph__ctx c;
     sph_status s;
     sph__idx i;
@@ -7988,6 +7989,17 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
     }
     /* the motion uses the final pressure */
     sph__iisph_pressure_acceleration(w, &c);
+    /* a solve that ends with a particle predicted beyond max_compression: which one (the
+       largest predicted compression under the final pressure; serial, only then) */
+    if (w->def.max_compression > 0 && errmax > (double)w->def.max_compression) {
+        size_t q;
+        sph_real emax = -1;
+        for (q = 0; q < w->n; ++q) {
+            const sph_real e = (sph__iisph_Ap_one(w, &c, q, c.dim, dt) - w->priv.src[q]) *
+                               c.pc[c.ph[q]].inv_rho0;
+            if (e > emax) { emax = e; worst = q; }
+        }
+    }
     sph__time(w, SPH_STAGE_PRESSURE, &t0);
     sph__record_nonpressure(w);
     SPH__OMP_FOR(w->n)
@@ -8006,11 +8018,11 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
        ends with a particle predicted beyond max_compression fails now, not one step late (where
        no smaller step can undo it) */
     if (s == SPH_OK && w->def.max_compression > 0 && errmax > (double)w->def.max_compression)
-        return sph__fail(w, SPH_ERR_UNSTABLE, -1,
-                         "step %llu (t = %g s): IISPH's solve ends with a particle predicted at "
-                         "rho/rho0 = %g (max_compression %g) after %d iterations: time step too "
-                         "large", (unsigned long long)w->steps, w->time, 1 + errmax,
-                         (double)w->def.max_compression, it);
+        return sph__fail(w, SPH_ERR_UNSTABLE, (long)worst,
+                         "step %llu (t = %g s): IISPH's solve ends with fluid particle %zu (id %u) "
+                         "predicted at rho/rho0 = %g (max_compression %g) after %d iterations: "
+                         "time step too large", (unsigned long long)w->steps, w->time, worst,
+                         (unsigned)w->id[worst], 1 + errmax, (double)w->def.max_compression, it);
     if (s == SPH_OK && (err > (double)w->def.tolerance ||
                         (w->def.tolerance_max > 0 && errmax > (double)w->def.tolerance_max)))
         s = sph__not_converged(w, "IISPH", it, err, errmax);

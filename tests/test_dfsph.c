@@ -652,38 +652,6 @@ static void test_df_retry(void) {
     sph_world_free(&w);
 }
 
-/* A step whose constant-density solve ends with a particle still predicted beyond
-   def.max_compression fails at that step (as IISPH's, tests/test_iisph.c), naming the particle:
-   water hitting a floor at 5 m/s, one 6 ms step with one sweep per solve. */
-static void test_df_overcompressed(void) {
-    sph_world_def def = sph_world_def_default(2);
-    sph_world w;
-    sph_phase water;
-    const sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)0.5, (sph_real)0.3},
-                   thi[2] = {(sph_real)0.5, (sph_real)0.5};
-    sph_status s;
-    size_t i;
-    memset(&water, 0, sizeof water);
-    water.rest_density = 1000;
-    def.solver = SPH_SOLVER_DFSPH;
-    def.spacing = (sph_real)0.025;
-    def.max_iterations = 1;
-    def.min_iterations = 1;
-    def.max_speed = 100;      /* neither the speed bound nor the displacement bound */
-    def.max_displacement = 3; /* is what this test is about */
-    CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
-    CHECK(sph_world_add_phase(&w, &water) == 0);
-    CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
-    CHECK_EQ_INT(sph_add_wall_box(&w, lo, thi, 0, 0), SPH_OK);
-    for (i = 0; i < w.n; ++i) w.v[2 * i + 1] = -5;
-    s = sph_step_dfsph(&w, (sph_real)0.006);
-    TH_NOTE("DFSPH, 5 m/s into the floor, dt 6 ms, 1 sweep: status %d: %s", (int)s, w.error);
-    CHECK_EQ_INT(s, SPH_ERR_UNSTABLE);
-    CHECK(strstr(w.error, "max_compression") != NULL);
-    CHECK(w.error_index >= 0 && (double)w.x[2 * (size_t)w.error_index + 1] < 0.1);
-    sph_world_free(&w);
-}
-
 const th_test tests_dfsph[] = {
     {"dfsph/tank_2d_every_boundary_scheme", test_df_tank_2d},
     {"dfsph/tank_3d", test_df_tank_3d},
@@ -694,6 +662,5 @@ const th_test tests_dfsph[] = {
     {"dfsph/paddle", test_df_paddle},
     {"dfsph/determinism_1_2_threads", test_df_determinism},
     {"dfsph/retry_keeps_standing_compression", test_df_retry},
-    {"dfsph/overcompressed_step_fails_at_its_step", test_df_overcompressed},
     {0, 0},
 };

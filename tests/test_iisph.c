@@ -414,36 +414,43 @@ static void test_iisph_determinism(void) {
 }
 
 /* A step whose solve ends with a particle still predicted beyond def.max_compression fails at
-   that step (SPH_ERR_UNSTABLE), so sph_advance can retry it smaller. The density check on the
-   step's own start would only see it one step later, when no smaller step can undo it. Water
-   hitting a floor at 5 m/s, one step of 6 ms (1.2 spacings) with at most two Jacobi sweeps: the predicted
+   that step (SPH_ERR_UNSTABLE) naming the particle, so sph_advance can retry it smaller. The
+   density check on the step's own start would only see it one step later, when no smaller step
+   can undo it. Water hitting a floor at 5 m/s, one step of 6 ms (1.2 spacings) with at most two
+   Jacobi sweeps (IISPH) or one sweep per solve (DFSPH's constant-density solve): the predicted
    compression at the floor stays far above 20 %. */
 static void test_overcompressed_step_fails(void) {
-    sph_world_def def = sph_world_def_default(2);
-    sph_world w;
-    sph_phase water;
-    const sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)0.5, (sph_real)0.3},
-                   thi[2] = {(sph_real)0.5, (sph_real)0.5};
-    sph_status s;
-    size_t i;
-    memset(&water, 0, sizeof water);
-    water.rest_density = 1000;
-    def.solver = SPH_SOLVER_IISPH;
-    def.spacing = (sph_real)0.025;
-    def.max_iterations = 2;
-    def.min_iterations = 1;
-    def.max_speed = 100;      /* neither the speed bound nor the displacement bound */
-    def.max_displacement = 3; /* is what this test is about */
-    CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
-    CHECK(sph_world_add_phase(&w, &water) == 0);
-    CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
-    CHECK_EQ_INT(sph_add_wall_box(&w, lo, thi, 0, 0), SPH_OK);
-    for (i = 0; i < w.n; ++i) w.v[2 * i + 1] = -5;
-    s = sph_step_iisph(&w, (sph_real)0.006);
-    TH_NOTE("IISPH, 5 m/s into the floor, dt 6 ms, 2 sweeps: status %d: %s", (int)s, w.error);
-    CHECK_EQ_INT(s, SPH_ERR_UNSTABLE);
-    CHECK(strstr(w.error, "max_compression") != NULL);
-    sph_world_free(&w);
+    static const sph_solver solvers[2] = {SPH_SOLVER_IISPH, SPH_SOLVER_DFSPH};
+    int si;
+    for (si = 0; si < 2; ++si) {
+        sph_world_def def = sph_world_def_default(2);
+        sph_world w;
+        sph_phase water;
+        const sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)0.5, (sph_real)0.3},
+                       thi[2] = {(sph_real)0.5, (sph_real)0.5};
+        sph_status s;
+        size_t i;
+        memset(&water, 0, sizeof water);
+        water.rest_density = 1000;
+        def.solver = solvers[si];
+        def.spacing = (sph_real)0.025;
+        def.max_iterations = si == 0 ? 2 : 1;
+        def.min_iterations = 1;
+        def.max_speed = 100;      /* neither the speed bound nor the displacement bound */
+        def.max_displacement = 3; /* is what this test is about */
+        CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
+        CHECK(sph_world_add_phase(&w, &water) == 0);
+        CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
+        CHECK_EQ_INT(sph_add_wall_box(&w, lo, thi, 0, 0), SPH_OK);
+        for (i = 0; i < w.n; ++i) w.v[2 * i + 1] = -5;
+        s = sph_step(&w, (sph_real)0.006);
+        TH_NOTE("%s, 5 m/s into the floor, dt 6 ms, %d sweep(s): status %d: %s",
+                si == 0 ? "IISPH" : "DFSPH", def.max_iterations, (int)s, w.error);
+        CHECK_EQ_INT(s, SPH_ERR_UNSTABLE);
+        CHECK(strstr(w.error, "max_compression") != NULL);
+        CHECK(w.error_index >= 0 && (double)w.x[2 * (size_t)w.error_index + 1] < 0.1);
+        sph_world_free(&w);
+    }
 }
 
 /* ---- conjugate gradients (def.pressure_solve = SPH_PSOLVE_CG) ------------------------------- */
@@ -573,7 +580,7 @@ static void test_cg_determinism(void) {
 
 const th_test tests_iisph[] = {
     {"iisph/hydrostatic_column", test_hydrostatic_column},
-    {"iisph/overcompressed_step_fails_at_its_step", test_overcompressed_step_fails},
+    {"iisph/overcompressed_step_fails_at_its_step", test_overcompressed_step_fails}, /* and DFSPH */
     {"iisph/iterations_grow_with_depth_and_dt", test_iterations_grow},
     {"iisph/boundary_schemes", test_boundary_schemes},
     {"iisph/single_layer_walls", test_single_layer_walls},
