@@ -710,12 +710,15 @@ static void test_auto_kernel(void) {
     { /* automatic values set after init: refused by the step, nothing changed */
         sph_world_def d = sph_world_def_default(3);
         sph_world w;
-        const sph_real lo[3] = {0, 0, 0}, hi[3] = {0.1f, 0.1f, 0.1f};
+        sph_phase water;
+        const sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)0.1, (sph_real)0.1, (sph_real)0.1};
         double t0;
+        memset(&water, 0, sizeof water);
+        water.rest_density = 1000;
         d.solver = SPH_SOLVER_IISPH;
         d.spacing = (sph_real)0.02;
         CHECK_EQ_INT(sph_world_init(&w, &d), SPH_OK);
-        CHECK(sph_world_add_phase(&w, &(sph_phase){.rest_density = 1000}) == 0);
+        CHECK(sph_world_add_phase(&w, &water) == 0);
         CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
         CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 0, 0), SPH_OK);
         t0 = w.time;
