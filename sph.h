@@ -1001,12 +1001,13 @@ typedef struct sph_world_def {
     sph_kernel_type kernel;    /* default SPH_KERNEL_AUTO: sph_world_init takes the cubic B-spline
                                   at h = dx (h_factor 0) in 3D for IISPH, DFSPH and PBF with zero
                                   wall pressure, else Wendland C2 (h = 1.3 dx). Measured on the 3D
-                                  dam break and tank (README, "The kernel in 3D"): the cubic's 33
-                                  neighbours against Wendland's 74 take those solvers through a
-                                  simulated second in about half the time at the same compression,
-                                  and their tank at rest is quieter; WCSPH's hydrostatic pressure
-                                  and extrapolated walls are worse with it. w.def holds the
-                                  kernel used                                                    */
+                                  dam break and tank (README, "The kernel in 3D"): the cubic's 26
+                                  lattice neighbours against Wendland's 80 take those solvers
+                                  through a simulated second in 0.5-0.7 of the time at the same
+                                  compression, and their tank at rest comes closer to rest;
+                                  WCSPH's hydrostatic pressure and extrapolated walls are worse
+                                  with it, and in 2D it gains nothing. w.def holds the kernel
+                                  used                                                           */
     sph_real gravity[3];       /* [m/s^2]; default (0, -9.81, 0) in 2D/3D (y is up), 0 in 1D;
                                   finite; components beyond dim are ignored                      */
     sph_solver solver;         /* used by sph_step / sph_advance (and sph_set_hydrostatic);
@@ -2994,7 +2995,7 @@ SPHDEF sph_world_def sph_world_def_default(int dim) {
     d.tolerance = SPH__R(0.001);  /* 0.1 % mean compression, Meiers 2025 */
     d.min_iterations = 2;
     d.max_iterations = 100;
-    /* automatic (sph_world_init, sph__auto_omega): Ihmsen et al. 2014, Meiers 2025: 0.5.
+    /* automatic (resolved by sph_world_init): Ihmsen et al. 2014, Meiers 2025: 0.5.
        Relaxed Jacobi converges while omega lambda_max < 2, lambda_max of D^-1 A: 2.6 on a 2D
        lattice, 4.1 on a 3D one and 5.4-5.7 once it disorders (Wendland C2, h = 1.3 dx: 21
        neighbours in 2D, 73 in 3D), so a kernel with that many neighbours gets 0.3 */
@@ -5815,7 +5816,8 @@ static sph_real sph__wall_fraction(const sph__ctx* c, const sph_real* xi, size_t
    the particle moved.
    In 3D with zero wall pressure and an incompressible solver d_c is for particles short of
    neighbours: one whose fluid and wall neighbours number at least a fraction "full" of a full
-   lattice neighbourhood (0.85 for Wendland C2 at h = 1.3 dx, see sph__contact_ramp) (the measure sph__enclosed uses) has the wall supply only what a fluid
+   lattice neighbourhood (0.85 for Wendland C2 at h = 1.3 dx, from the kernel's lattice by
+   sph__contact_ramp; the count sph__enclosed uses) has the wall supply only what a fluid
    would, so the pressure solve, which holds its density, holds it, and its contact distance is
    SPH__CONTACT_REST dx (over a wall particle its centre stays 0.1 dx on the fluid side of the
    wall's face; over the hollow between wall particles it is free to reach the face, where zero
@@ -6417,8 +6419,8 @@ static sph_status sph__reserve_blocks(sph_world* w) {
 /* w.def as a step finds it: a host may change the tunable fields between steps (tolerances,
    limits, callbacks, the solver), within their ranges; the fields the world was built from (dim,
    spacing, kernel, h_factor, periodic directions and their box) and the ones sph_world_init
-   resolved (boundary_pressure, boundary_gamma and an automatic omega, see there) must stay. A bad value fails the
-   step with SPH_ERR_ARG naming the field, before anything changed. */
+   resolved (boundary_pressure, boundary_gamma and an automatic omega, see there) must stay. A
+   bad value fails the step with SPH_ERR_ARG naming the field, before anything changed. */
 static sph_status sph__check_def_now(sph_world* w) {
     const sph_world_def* d = &w->def;
     int k, changed = d->dim != w->dim || d->spacing != w->dx || d->kernel != w->kernel.type ||
