@@ -3102,7 +3102,8 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
     SPH__CHECK(sph__finite((double)d->h_factor) && d->h_factor >= 0 && d->h_factor <= 100,
                "sph_world_def.h_factor = %g: must be 0 (kernel default) or in (0, 100]",
                (double)d->h_factor);
-    SPH__CHECK(d->kernel == SPH_KERNEL_AUTO || ((int)d->kernel >= 0 && d->kernel < SPH_KERNEL_COUNT),
+    SPH__CHECK(d->kernel == SPH_KERNEL_AUTO ||
+                   ((int)d->kernel >= 0 && d->kernel < SPH_KERNEL_COUNT),
                "sph_world_def.kernel = %d: not a sph_kernel_type", (int)d->kernel);
     for (k = 0; k < 3; ++k)
         SPH__CHECK(sph__finite((double)d->gravity[k]), "sph_world_def.gravity[%d] = %g: not finite",
@@ -3397,7 +3398,9 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
                           (def->solver == SPH_SOLVER_IISPH || def->solver == SPH_SOLVER_DFSPH ||
                            def->solver == SPH_SOLVER_PBF);
         w->def.kernel = cubic ? SPH_KERNEL_CUBIC : SPH_KERNEL_WENDLAND_C2;
-        hf = def->h_factor > 0 ? def->h_factor : cubic ? 1 : sph_kernel_default_h_factor(w->def.kernel);
+        hf = def->h_factor > 0 ? def->h_factor
+             : cubic           ? 1
+                               : sph_kernel_default_h_factor(w->def.kernel);
     } else {
         hf = def->h_factor > 0 ? def->h_factor : sph_kernel_default_h_factor(def->kernel);
     }
