@@ -6606,6 +6606,22 @@ static sph_status sph__shift_reserve(sph_world* w) {
     return sph__scratch(w, &w->priv.shift, w->capacity * (size_t)w->dim);
 }
 
+/* One neighbour's share of the shift direction: g += V_j (1 + 0.2 (W_ij / W(dx))^4) grad W_ij
+   (a fluid neighbour, V_j = m_j / rho_j, or a wall particle, V_j its volume). */
+SPH__INLINE void sph__shift_pair(const sph__ctx* c, sph_real inv_wdx, const sph_real* xi,
+                                 const sph_real* xj, sph_real vol, const int D, sph_real* g) {
+    sph_real d[3] = {0, 0, 0}, r2 = 0, q, wr, f;
+    int k;
+    sph__delta_vec_p(c, c->periodic_any, xi, xj, d, D);
+    SPH__FOR_K(D, r2 += d[k] * d[k]);
+    q = sph__sqrt(r2) * c->k.inv_h;
+    wr = sph__kw(c->k.form, q) * inv_wdx;
+    wr *= wr;
+    f = (1 + SPH__R(0.2) * wr * wr) * vol * c->k.norm_g *
+        sph__kf(c->k.form, q); /* grad W_ij = norm_g f(q) x_ij */
+    SPH__FOR_K(D, g[k] += f * d[k]);
+}
+
 static void sph__stage_shift(sph_world* w, const sph__ctx* c, sph_real dt) {
     const int D = c->dim, form = c->k.form;
     const sph_real inv_wdx = 1 / sph__kw(form, w->dx * c->k.inv_h);
@@ -6621,29 +6637,15 @@ static void sph__stage_shift(sph_world* w, const sph__ctx* c, sph_real dt) {
         int k;
         for (kk = k0; kk < k1; ++kk) {
             const size_t j = c->ff->idx[kk];
-            sph_real d[3] = {0, 0, 0}, r2 = 0, q, wr, f;
-            sph__delta_vec_p(c, c->periodic_any, xi, c->x + j * (size_t)D, d, D);
-            SPH__FOR_K(D, r2 += d[k] * d[k]);
-            q = sph__sqrt(r2) * c->k.inv_h;
-            wr = sph__kw(form, q) * inv_wdx;
-            wr *= wr;
-            f = (1 + SPH__R(0.2) * wr * wr) * (c->m ? c->m[j] : c->m0) / c->rho[j] *
-                c->k.norm_g * sph__kf(form, q); /* grad W_ij = norm_g f(q) x_ij */
-            SPH__FOR_K(D, g[k] += f * d[k]);
+            sph__shift_pair(c, inv_wdx, xi, c->x + j * (size_t)D,
+                            (c->m ? c->m[j] : c->m0) / c->rho[j], D, g);
         }
         if (c->has_b) {
             k0 = c->fb->begin[i];
             k1 = k0 + c->fb->count[i];
             for (kk = k0; kk < k1; ++kk) {
                 const size_t b = c->fb->idx[kk];
-                sph_real d[3] = {0, 0, 0}, r2 = 0, q, wr, f;
-                sph__delta_vec_p(c, c->periodic_any, xi, c->bx + b * (size_t)D, d, D);
-                SPH__FOR_K(D, r2 += d[k] * d[k]);
-                q = sph__sqrt(r2) * c->k.inv_h;
-                wr = sph__kw(form, q) * inv_wdx;
-                wr *= wr;
-                f = (1 + SPH__R(0.2) * wr * wr) * c->bvol[b] * c->k.norm_g * sph__kf(form, q);
-                SPH__FOR_K(D, g[k] += f * d[k]);
+                sph__shift_pair(c, inv_wdx, xi, c->bx + b * (size_t)D, c->bvol[b], D, g);
             }
         }
         SPH__FOR_K(D, sh[(size_t)i * (size_t)D + (size_t)k] = coef * g[k]);
