@@ -781,6 +781,24 @@ typedef struct rest_result {
     char error[SPH_ERROR_SIZE];
 } rest_result;
 
+/* Adds one particle's sample to r: its speed v (to the late maximum too when late), and how far
+   a water particle rose above, or an air particle sank below, the interface rows' start (the
+   interface at height Hw, rows half a spacing dy either side). */
+/* The end of a run: steps, time and message of w into r, and w freed. */
+static void rest_finish(rest_result* r, sph_world* w) {
+    r->steps = (unsigned long long)w->steps;
+    r->t = w->time;
+    snprintf(r->error, sizeof r->error, "%s", w->error);
+    sph_world_free(w);
+}
+
+static void rest_sample(rest_result* r, int air, double y, double v, int late, double Hw, double dy) {
+    if (v > r->vmax[air]) r->vmax[air] = v;
+    if (late && v > r->vlate[air]) r->vlate[air] = v;
+    if (!air && y - (Hw - 0.5 * dy) > r->rise) r->rise = y - (Hw - 0.5 * dy);
+    if (air && (Hw + 0.5 * dy) - y > r->sink) r->sink = (Hw + 0.5 * dy) - y;
+}
+
 /* Water (1000 kg/m^3) on [0, 0.5), air (1 kg/m^3) on [0.5, 1) in a tank 1 m wide, periodic in x,
    with walls at the floor and the lid, gravity 9.81 m/s^2, dx = 0.025 m, particles on a
    hexagonal lattice (rows dx sqrt(3)/2 apart, stretched to fit). Decisions, measured:
@@ -808,11 +826,27 @@ static int rest_holds(const rest_result* r) {
            r->rise < 0.0125 && r->sink < 0.0125;
 }
 
+/* The step of the 1000:1 water/air scenes below (Ott & Schnetter 2003's compressible step):
+   spacing dx, the density form and pressure gradient given, artificial viscosity 0.2,
+   delta-SPH 0.1, gravity g downwards. */
+static sph_world_def water_air_def(double dx, sph_density density, sph_pressure_grad pgrad,
+                                   double g) {
+    sph_world_def def = sph_world_def_default(2);
+    def.spacing = (sph_real)dx;
+    def.solver = SPH_SOLVER_COMPRESSIBLE;
+    def.density = density;
+    def.pressure_grad = pgrad;
+    def.alpha = (sph_real)0.2;
+    def.delta = (sph_real)0.1;
+    def.gravity[1] = (sph_real)-g;
+    return def;
+}
+
 static rest_result interface_at_rest(sph_density density, double t_end) {
     const double dx = 0.025, Hw = 0.5, g = 9.81, cw = 10 * sqrt(2 * g * 1.0), pb = 2000;
     const int nx = 40, ny = (int)floor(Hw / (dx * 0.8660254) + 0.5); /* rows per phase */
     const double dy = Hw / ny;
-    sph_world_def def = sph_world_def_default(2);
+    sph_world_def def = water_air_def(dx, density, SPH_PGRAD_INTERFACE, g);
     sph_world w;
     rest_result r;
     sph_real lo[2] = {0, 0}, top[2] = {1, 1};
@@ -821,13 +855,6 @@ static rest_result interface_at_rest(sph_density density, double t_end) {
     sph_real* rho = (sph_real*)malloc((size_t)(nx * ny) * sizeof(sph_real));
     int ph, idx[2], k;
     memset(&r, 0, sizeof r);
-    def.spacing = (sph_real)dx;
-    def.solver = SPH_SOLVER_COMPRESSIBLE;
-    def.density = density;
-    def.pressure_grad = SPH_PGRAD_INTERFACE;
-    def.alpha = (sph_real)0.2;
-    def.delta = (sph_real)0.1;
-    def.gravity[1] = (sph_real)-g;
     def.periodic[0] = 1;
     def.domain_lo[0] = 0;
     def.domain_hi[0] = 1;
@@ -860,21 +887,14 @@ static rest_result interface_at_rest(sph_density density, double t_end) {
         for (i = 0; i < w.n; ++i) {
             const double y = (double)w.x[2 * i + 1];
             const double v = hypot((double)w.v[2 * i], (double)w.v[2 * i + 1]);
-            const int a = w.phase[i] == idx[1];
-            if (v > r.vmax[a]) r.vmax[a] = v;
-            if (k > 10 && v > r.vlate[a]) r.vlate[a] = v;
-            if (!a && y - (Hw - 0.5 * dy) > r.rise) r.rise = y - (Hw - 0.5 * dy);
-            if (a && (Hw + 0.5 * dy) - y > r.sink) r.sink = (Hw + 0.5 * dy) - y;
+            rest_sample(&r, w.phase[i] == idx[1], y, v, k > 10, Hw, dy);
         }
         if (!rest_holds(&r)) {
             r.t_break = w.time;
             break;
         }
     }
-    r.steps = (unsigned long long)w.steps;
-    r.t = w.time;
-    snprintf(r.error, sizeof r.error, "%s", w.error);
-    sph_world_free(&w);
+    rest_finish(&r, &w);
     free(x);
     free(m);
     free(rho);
@@ -926,17 +946,10 @@ static void test_interface_at_rest_long(void) {
    of its nearest fluid particle (sph__phase_walls in sph.h). */
 static sph_status contact_line_scene(sph_world* w, int* air, sph_pressure_grad pgrad) {
     const double dx = 0.025, g = 9.81, cw = 10 * sqrt(2 * g * 1.0), pb = 2000;
-    sph_world_def def = sph_world_def_default(2);
+    sph_world_def def = water_air_def(dx, SPH_DENSITY_PARTICLE, pgrad, g);
     sph_real lo[2] = {0, 0}, mid[2] = {1, (sph_real)0.5}, mid0[2] = {0, (sph_real)0.5},
              top[2] = {1, 1};
     int water;
-    def.spacing = (sph_real)dx;
-    def.solver = SPH_SOLVER_COMPRESSIBLE;
-    def.density = SPH_DENSITY_PARTICLE;
-    def.pressure_grad = pgrad;
-    def.alpha = (sph_real)0.2;
-    def.delta = (sph_real)0.1;
-    def.gravity[1] = (sph_real)-g;
     if (sph_world_init(w, &def) != SPH_OK) return w->status;
     water = add_phase(w, 1000, SPH_EOS_TAIT, 0, (sph_real)cw, (sph_real)pb, 0);
     *air = add_phase(w, 1, SPH_EOS_TAIT, (sph_real)1.4, 150, (sph_real)pb, 0);
@@ -1005,11 +1018,7 @@ static rest_result contact_line_run(sph_pressure_grad pgrad, double t_end, doubl
         for (i = 0; i < w.n; ++i) {
             const double x = (double)w.x[2 * i], y = (double)w.x[2 * i + 1];
             const double v = hypot((double)w.v[2 * i], (double)w.v[2 * i + 1]);
-            const int a = w.phase[i] == air;
-            if (v > r.vmax[a]) r.vmax[a] = v;
-            if (w.time > t_late - 1e-9 && v > r.vlate[a]) r.vlate[a] = v;
-            if (!a && y - (Hw - 0.5 * dx) > r.rise) r.rise = y - (Hw - 0.5 * dx);
-            if (a && (Hw + 0.5 * dx) - y > r.sink) r.sink = (Hw + 0.5 * dx) - y;
+            rest_sample(&r, w.phase[i] == air, y, v, w.time > t_late - 1e-9, Hw, dx);
             out = fmax(out, fmax(fmax(-x, x - 1), fmax(-y, y - 1)));
         }
         if (r.status == SPH_OK && out > 0.5 * dx) ++*escapes;
@@ -1020,10 +1029,7 @@ static rest_result contact_line_run(sph_pressure_grad pgrad, double t_end, doubl
             break;
         }
     }
-    r.steps = (unsigned long long)w.steps;
-    r.t = w.time;
-    snprintf(r.error, sizeof r.error, "%s", w.error);
-    sph_world_free(&w);
+    rest_finish(&r, &w);
     return r;
 }
 
@@ -1092,19 +1098,12 @@ typedef struct dam_result {
 static dam_result dam_1000_to_1(int with_air, sph_pressure_grad pgrad) {
     const double a = 0.2, g = 9.81, dx = a / 10, ts = sqrt(a / (2 * g)), U = sqrt(2 * g * a);
     const double pb = with_air ? 2000 : 0;
-    sph_world_def def = sph_world_def_default(2);
+    sph_world_def def = water_air_def(dx, SPH_DENSITY_PARTICLE, pgrad, g);
     sph_world w;
     dam_result r;
     sph_real lo[2] = {0, 0}, col[2], tank[2], alo[2], ahi[2];
     int k, air = -1;
     memset(&r, 0, sizeof r);
-    def.spacing = (sph_real)dx;
-    def.solver = SPH_SOLVER_COMPRESSIBLE;
-    def.density = SPH_DENSITY_PARTICLE;
-    def.pressure_grad = pgrad;
-    def.alpha = (sph_real)0.2;
-    def.delta = (sph_real)0.1;
-    def.gravity[1] = (sph_real)-g;
     col[0] = (sph_real)a; col[1] = (sph_real)(2 * a);
     tank[0] = (sph_real)(5 * a); tank[1] = (sph_real)(3 * a);
     r.status = sph_world_init(&w, &def);
