@@ -202,6 +202,7 @@ static df_dam run_df_dam(sph_world_def def, int res) {
     int k;
     size_t i;
     memset(&r, 0, sizeof(r));
+    memset(&d, 0, sizeof(d)); /* set by scene_dam_break; gcc -O2 without OpenMP cannot tell */
     if (scene_dam_break(&w, def, 0.1, res, &d) != SPH_OK) {
         CHECK_MSG(0, "scene: %s", scene_error);
         r.failed = 1;
