@@ -1,33 +1,35 @@
 /* realtime.c - an interactive 2D SPH tank for game programmers (SDL2).
    10k water particles in a closed tank: stir them with the mouse, run a wave paddle, switch
    between the four pressure solvers while it runs. By default the tank is at game scale,
-   20 m x 12.5 m with 5 m of water and 0.1 m particles (--scale 1: the 1.6 m x 1.0 m model tank
-   it is scaled from, see "scene"), stepped by IISPH at a 0.5 % mean compression tolerance with
-   sph.h's own step control. Each frame simulates the wall time of the last frame within a budget
-   of wall time, so the window stays responsive; the top line shows the real-time factor
-   (simulated seconds per wall second). When the water falls behind real time for 2 s, the demo
-   starts a fresh tank with fewer particles and says so (--adapt 0: keep the detail, run in
-   slow motion instead).
+   80 m x 50 m with 20 m of water and 0.4 m particles (--scale 1: the 1.6 m x 1.0 m model tank
+   it is scaled from, see "scene"), stepped by PBF (position based fluids) aiming at a 2 % mean
+   compression (1.4-2 % measured) with sph.h's own step control; IISPH at a 0.5 % tolerance is
+   key 3 (0.5 % compression, about 1.4 times PBF's CPU time here). Each frame simulates
+   the wall time of the last frame within a budget of wall time, so the window stays
+   responsive; the top line shows the real-time factor (simulated seconds per wall second).
+   When the water falls behind real time for 2 s, the demo starts a fresh tank with fewer
+   particles and says so (--adapt 0: keep the detail, run in slow motion instead).
 
    Build: cc -O2 -std=c99 -fopenmp -I. examples/realtime.c $(sdl2-config --cflags --libs) -lm \
              -o build/realtime                       (or: make realtime; Debian: libsdl2-dev)
-   Run:   ./build/realtime [--particles 10000] [--solver wcsph|pcisph|iisph|pbf] [--scale 12.5]
+   Run:   ./build/realtime [--particles 10000] [--solver wcsph|pcisph|iisph|pbf] [--scale 50]
                            [--tolerance 0.005 (IISPH's)] [--compression 0.02 (PBF's)] [--adapt 1]
                            [--budget 40 (ms per frame)]
    Check: xvfb-run -a ./build/realtime --frames 150 --screenshot out/realtime.png [--solver iisph]
           runs scripted input (a stirring drag, a pull, the paddle) without a user, then writes
           the last frame as a PNG, one summary line per solver and the final line
-          "real-time factor X at N particles, solver S" (simulated time over wall time of all
-          frames, drawing included; N at the end); exit status 1 if a step failed or a particle
+          "real-time factor X at N particles, solver S" (simulated time over the wall time the
+          frames asked for, from the first frame's start to the last one's, drawing included,
+          as the text band shows it; N at the end); exit status 1 if a step failed or a particle
           left the tank. Without --solver the run switches WCSPH -> PCISPH -> IISPH -> PBF at
           each quarter. SDL_VIDEODRIVER=offscreen or dummy also work.
 
    Keys:  left mouse   stir: drags the water near the cursor along with the cursor's motion
           right mouse  pull: draws the water near the cursor towards it
           1 / 2 / 3 / 4  WCSPH / PCISPH (enhanced) / IISPH / PBF (rebuilds the world from the
-                       current particle positions and velocities); IISPH runs first: PBF, the
-                       position based solver meant for games, is 1.25 times quicker here but
-                       three times as compressed (README, "Real time in a game")
+                       current particle positions and velocities); PBF runs first: the
+                       position based solver meant for games, about 1.4 times quicker than
+                       IISPH here but four times as compressed (README, "Real time in a game")
           P paddle on/off   R reset   Esc quit
    Threads: OpenMP uses every core. On a machine busy with other work, OMP_WAIT_POLICY=passive
    keeps waiting threads from spinning (with gcc's default a step can take 10x longer there). */
@@ -48,7 +50,7 @@
    every time and speed times sqrt(S), accelerations unchanged, kinematic viscosity times
    S^1.5. The flow is then the model's, sqrt(S) times slower, and so is every step sph.h
    chooses: the step grows like sqrt(dx) under gravity while the particle count stays. */
-#define SCALE 12.5    /* default: a 20 m x 12.5 m tank, 5 m of water, 0.1 m particles at 10k */
+#define SCALE 50.0    /* default: an 80 m x 50 m tank, 20 m of water, 0.4 m particles at 10k */
 #define TANK_W 1.6    /* model tank interior [m] */
 #define TANK_H 1.0
 #define DEPTH 0.4     /* water depth at rest [m]; the particle count sets the spacing */
@@ -487,7 +489,9 @@ static void particle_rect(const demo* d, const sph_real* x, int size, SDL_Rect* 
 }
 
 /* Walls grey, paddle dark grey, water coloured by speed: particles are sorted into NBIN colour
-   bins so the renderer gets one SDL_RenderFillRects call per colour. */
+   bins so the renderer gets one SDL_RenderFillRects call per colour. With the software renderer
+   this and the text band take about 1 ms a frame at 10k particles; rasterising the squares
+   into one streaming texture instead measured 1.2-1.3 ms (README, "Real time in a game"). */
 static void draw_particles(SDL_Renderer* r, demo* d) {
     static unsigned char colour[NBIN][3];
     size_t count[NBIN], start[NBIN + 1], i, nw;
@@ -561,12 +565,16 @@ static void draw_hud(SDL_Renderer* r, SDL_Texture* tex, img* hud, const demo* d,
 
 /* Check mode: what each solver did, and its frame times [ms] to take the median of. */
 typedef struct tally {
-    double *ms_frame, *ms_sim;
+    double *ms_frame, *ms_sim, *ms_draw, *ms_present; /* draw: into the renderer (particles,
+                                                         cursor, text band); present: the flip */
     int frames;
     long steps;
     double simulated; /* [s] */
-    double wall, cpu; /* wall time of its frames, drawing included, and the process's CPU time in
-                         them (all threads) [s]: cpu / wall near the thread count = a free machine */
+    double asked;     /* wall time its frames were to simulate, drawing included [s]: each frame
+                         simulates the interval from the last frame's start to its own (real_dt),
+                         so simulated / asked is the factor the text band shows */
+    double wall, cpu; /* wall time of its frames, and the process's CPU time in them (all
+                         threads) [s]: cpu / wall near the thread count = a free machine */
     double comp_max;  /* largest mean compression after a frame [-] */
     double comp_sum;  /* mean compressions after the frames, summed [-] */
     size_t outside;   /* most particles outside the tank after any frame */
@@ -593,9 +601,15 @@ static int parse_solver(const char* s) {
 
 /* A window with a renderer. A check run (hidden window) falls back to SDL's offscreen and dummy
    video drivers when there is no display, and prefers the software renderer, so that
-   SDL_RenderReadPixels needs no GPU; the software renderer is the fallback everywhere. */
+   SDL_RenderReadPixels needs no GPU; the software renderer is the fallback everywhere. The
+   software renderer draws into the window's framebuffer, which SDL by default shows through an
+   OpenGL texture where it can: under Xvfb that is Mesa's software rasteriser, and it cost 5-14
+   ms per present at 960 x 690 px here (measured with SDL_FRAMEBUFFER_ACCELERATION=1 against 0).
+   The X11 driver's own framebuffer (shared memory) takes 0.1-0.8 ms, so the demo asks for it
+   (hint SDL_FRAMEBUFFER_ACCELERATION=0; the environment variable of that name overrides). */
 static SDL_Renderer* open_window(int w, int h, int check, SDL_Window** win) {
     SDL_Renderer* ren = NULL;
+    SDL_SetHint(SDL_HINT_FRAMEBUFFER_ACCELERATION, "0"); /* read by the software renderer only */
     if (SDL_Init(SDL_INIT_VIDEO) != 0 && check) {
         SDL_setenv("SDL_VIDEODRIVER", "offscreen", 1);
         if (SDL_Init(SDL_INIT_VIDEO) != 0) {
@@ -621,7 +635,7 @@ int main(int argc, char** argv) {
     SDL_Window* win = NULL;
     SDL_Renderer* ren;
     SDL_Texture* tex = NULL;
-    double t_prev, sim_dt = 0, run_sim = 0, run_wall = 0;
+    double t_prev, sim_dt = 0, run_sim = 0, run_asked = 0;
 
     memset(&d, 0, sizeof(d));
     memset(&hudm, 0, sizeof(hudm));
@@ -656,14 +670,17 @@ int main(int argc, char** argv) {
                 SCALE, TOL_IISPH, PBF_COMPRESSION);
         return 2;
     }
-    /* IISPH by default: in the 20 m tank at 10k particles neither keeps up with real time; PBF
-       at its 2 % target gets 1.25 times further, at three times IISPH's compression (README,
-       "Real time in a game"); the check without --solver goes through all four in key order */
-    d.solver = fixed >= 0 ? fixed : frames > 0 ? 0 : 2;
+    /* PBF by default: in the 80 m tank at 10k particles it needs 0.68-0.86 CPU seconds per
+       simulated second, drawing included (IISPH about 1.4 times as much), at a mean compression
+       of 1.4-2 % against IISPH's 0.5 % (README, "Real time in a game"); the check without
+       --solver goes through all four in key order */
+    d.solver = fixed >= 0 ? fixed : frames > 0 ? 0 : 3;
     for (k = 0; k < NSOLVER && frames > 0; ++k) {
         tal[k].ms_frame = (double*)malloc(sizeof(double) * (size_t)frames);
         tal[k].ms_sim = (double*)malloc(sizeof(double) * (size_t)frames);
-        if (!tal[k].ms_frame || !tal[k].ms_sim) return 1;
+        tal[k].ms_draw = (double*)malloc(sizeof(double) * (size_t)frames);
+        tal[k].ms_present = (double*)malloc(sizeof(double) * (size_t)frames);
+        if (!tal[k].ms_frame || !tal[k].ms_sim || !tal[k].ms_draw || !tal[k].ms_present) return 1;
     }
 
     /* the window: the tank and its walls (support radius / dx layers, rounded up) fill the width
@@ -708,7 +725,7 @@ int main(int argc, char** argv) {
     while (running) {
         const double t0 = now(), real_dt = t0 - t_prev;
         const clock_t c0 = clock();
-        double t_sim0, sim_ms, frame_ms;
+        double t_sim0, sim_ms, frame_ms, draw_ms, present_ms;
         sph_status s;
         SDL_Event ev;
         t_prev = t0;
@@ -767,11 +784,16 @@ int main(int argc, char** argv) {
         }
 
         /* draw; the screenshot is read back before SDL_RenderPresent */
+        draw_ms = now();
         SDL_SetRenderDrawColor(ren, 250, 250, 247, 255);
         SDL_RenderClear(ren);
         draw_particles(ren, &d);
         draw_cursor(ren, &d);
         draw_hud(ren, tex, &hud, &d, &hudm);
+#if SDL_VERSION_ATLEAST(2, 0, 10)
+        SDL_RenderFlush(ren); /* the renderer's queued commands run here, not in the present */
+#endif
+        draw_ms = 1e3 * (now() - draw_ms);
         if (shot && frame == frames - 1) {
             img pic;
             if (!img_init(&pic, WIN_W, d.win_h) ||
@@ -782,12 +804,16 @@ int main(int argc, char** argv) {
             }
             img_free(&pic);
         }
+        present_ms = now();
         SDL_RenderPresent(ren);
+        present_ms = 1e3 * (now() - present_ms);
         frame_ms = 1e3 * (now() - t0);
         meter_add(&hudm, sim_ms, frame_ms, steps, sim_dt, real_dt);
         if (frames > 0) {
             tally* t = &tal[d.solver];
             t->ms_frame[t->frames] = frame_ms;
+            t->ms_draw[t->frames] = draw_ms;
+            t->ms_present[t->frames] = present_ms;
             t->ms_sim[t->frames++] = sim_ms;
             t->n = d.w.n;
         }
@@ -797,8 +823,9 @@ int main(int argc, char** argv) {
             tally* t = &tal[d.solver];
             const double wall = now() - t0;
             t->wall += wall;
+            t->asked += real_dt;
             t->cpu += (double)(clock() - c0) / CLOCKS_PER_SEC;
-            run_wall += wall;
+            run_asked += real_dt;
             run_sim += s == SPH_OK ? sim_dt : 0;
             if (++frame >= frames) running = 0;
         } else if (frame_ms < 4) {
@@ -810,12 +837,14 @@ int main(int argc, char** argv) {
     for (k = 0; k < NSOLVER; ++k) {
         const tally* t = &tal[k];
         if (t->frames == 0) continue;
-        printf("realtime: %-6s particles %zu  frames %d  median %.1f ms/frame (sim %.1f ms)  "
-               "steps %ld (%.1f/frame)  simulated %.3f s in %.3f s (cpu %.2f s)  factor %.3f  "
-               "compression mean %.2f %%, <= %.2f %%  outside %zu  errors %d\n",
+        printf("realtime: %-6s particles %zu  frames %d  median %.1f ms/frame (sim %.1f, draw "
+               "%.1f, present %.1f ms)  steps %ld (%.1f/frame)  simulated %.3f s of %.3f s "
+               "(frames %.3f s, cpu %.2f s)  factor %.3f  compression mean %.2f %%, <= %.2f %%  "
+               "outside %zu  errors %d\n",
                solver_arg[k], t->n, t->frames, median(t->ms_frame, t->frames),
-               median(t->ms_sim, t->frames), t->steps, (double)t->steps / t->frames, t->simulated,
-               t->wall, t->cpu, t->wall > 0 ? t->simulated / t->wall : 0,
+               median(t->ms_sim, t->frames), median(t->ms_draw, t->frames),
+               median(t->ms_present, t->frames), t->steps, (double)t->steps / t->frames,
+               t->simulated, t->asked, t->wall, t->cpu, t->asked > 0 ? t->simulated / t->asked : 0,
                100 * t->comp_sum / t->frames, 100 * t->comp_max,
                t->outside, t->errors);
         if (t->outside > 0 || t->errors > 0) status = 1;
@@ -828,12 +857,14 @@ int main(int argc, char** argv) {
                len(TANK_H), len(DEPTH), d.dx, d.tol_iisph, d.pbf_compression, getenv("OMP_WAIT_POLICY") ? getenv("OMP_WAIT_POLICY") : "unset");
         if (shot && status == 0) printf("realtime: screenshot %s\n", shot);
         printf("real-time factor %.3g at %zu particles, solver %s\n",
-               run_wall > 0 ? run_sim / run_wall : 0, d.w.n,
+               run_asked > 0 ? run_sim / run_asked : 0, d.w.n,
                fixed >= 0 ? solver_arg[fixed] : "wcsph+pcisph+iisph+pbf");
     }
     for (k = 0; k < NSOLVER; ++k) {
         free(tal[k].ms_frame);
         free(tal[k].ms_sim);
+        free(tal[k].ms_draw);
+        free(tal[k].ms_present);
     }
     free(d.rects);
     free(d.bin);
