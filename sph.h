@@ -8392,8 +8392,8 @@ SPHDEF sph_status sph_step_dfsph(sph_world* w, sph_real dt) {
                eps_r times what a lattice particle's own constraint contributes, so eps_r = 1
                moves it half the way its own constraint asks: Jacobi sums the corrections of all
                neighbours' constraints and overshoots without it (measured in the 20 m tank of
-               examples/realtime.c at the same compression target: eps_r = 0.25 failed the
-               compression check at t = 0.21 s; 0.5 ran at 2-2.7 % mean compression against
+               examples/realtime.c, --scale 12.5, at the same compression target: eps_r = 0.25
+               failed the compression check at t = 0.21 s; 0.5 ran at 2-2.7 % mean compression against
                1.4-1.8 % at 1, at the 1.15 times longer step the rule then gives). The walls do
                not move and
                carry no multiplier: the constraint's own wall term (zero wall pressure; >>iisph
@@ -8792,7 +8792,8 @@ static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
    0.11 %). The limit is the dt of c = def.pbf_compression. K = 0.12 from 2D tanks at rest,
    started from rest density, through sph_advance in frames of 1/60 s (3 projections, eps_r = 1;
    mean over the frames): a 1 m tank 20 layers deep settled to 0.55, 0.97 and 1.79 % at targets
-   of 0.5, 1 and 2 % (2 s), the 20 m tank of examples/realtime.c (50 layers, 10k particles) to
+   of 0.5, 1 and 2 % (2 s), the 20 m tank of examples/realtime.c at --scale 12.5 (50 layers,
+   10k particles) to
    0.95 and 1.76 % at 1 and 2 % (3 s), the 40-layer tank of tests/test_pbf.c to 1.17 % at 1 %
    (frames of 0.05 s). A start from rest density overshoots
    about twice the mean it settles to (the fluid falls until its compression carries it): the
