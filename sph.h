@@ -1240,6 +1240,10 @@ typedef struct sph_stats {
 /* Private state (do not touch). */
 typedef struct sph__private {
     sph_grid grid, bgrid;           /* fluid and boundary grids (same cells)                       */
+    uint8_t* b_near;                /* per cell of bgrid's dense table: a wall particle in the 3^dim
+                                       cells around it (sph__grid_near); NULL-like when b_near_on 0 */
+    size_t b_near_cap;
+    int b_near_on;                  /* b_near holds the current bgrid's cells                      */
     sph_neighbors ff, fb, bf, bb;   /* fluid->fluid, fluid->boundary, boundary->fluid, ->boundary  */
     sph_neighbors cff, cfb, cbf;    /* def.neighbor_skin > 0: the candidate lists within (1 + skin)
                                        R that ff, fb and bf are filtered from every step        */
@@ -2428,7 +2432,7 @@ SPH__INLINE size_t sph__row_within(const sph_real* x, const sph_real* p, size_t 
 SPH__INLINE size_t sph__neighbors_chunk_dense(sph_neighbors* nl, const sph_grid* g,
                                               const sph_real* x, const sph_real* xq, size_t nq,
                                               sph_real radius, int exclude_self, size_t c,
-                                              const int D) {
+                                              const uint8_t* near, const int D) {
     const sph_real r2max = radius * radius;
     const int64_t ex0 = g->ext[0], ex1 = D > 1 ? g->ext[1] : 1, ex2 = D > 2 ? g->ext[2] : 1;
     size_t i, i0 = c * SPH__CHUNK, i1 = i0 + SPH__CHUNK;
@@ -2474,6 +2478,11 @@ SPH__INLINE size_t sph__neighbors_chunk_dense(sph_neighbors* nl, const sph_grid*
                wall particles of a tank, queried against the fluid's grid every step) */
             outside |= cc[k] < -1 || cc[k] > g->ext[k];
         }
+        /* a cell of the box with no point in the 3^D cells around it (sph__grid_near): the
+           fluid inside a tank, queried against the walls' grid every step */
+        if (near && cc[0] >= 0 && cc[0] < ex0 && cc[1] >= 0 && cc[1] < ex1 && cc[2] >= 0 &&
+            cc[2] < ex2 && !near[(cc[2] * ex1 + cc[1]) * ex0 + cc[0]])
+            outside = 1;
         if (!outside) {
             /* Cells of the stencil that lie wholly beyond the radius are skipped: a row (dy, dz)
                whose nearest point is farther than the radius, and the end cells of a row (the
@@ -2615,9 +2624,11 @@ static int sph__neighbors_room(sph_neighbors* nl) {
     return overflow;
 }
 
-static sph_status sph__neighbors_build(sph_neighbors* nl, const sph_grid* g, const sph_real* x,
-                                       const uint32_t* order, const sph_real* xq, size_t nq,
-                                       sph_real radius, int exclude_self) {
+/* near: NULL, or sph__grid_near's table of g (dense grids without periodic directions). */
+static sph_status sph__neighbors_build_near(sph_neighbors* nl, const sph_grid* g,
+                                            const sph_real* x, const uint32_t* order,
+                                            const sph_real* xq, size_t nq, sph_real radius,
+                                            int exclude_self, const uint8_t* near) {
     const size_t nchunk = (nq + SPH__CHUNK - 1) / SPH__CHUNK;
     int pass;
     if (!sph__neighbors_reserve(nl, nq, nchunk)) return sph__neighbors_nomem(nl);
@@ -2630,11 +2641,11 @@ static sph_status sph__neighbors_build(sph_neighbors* nl, const sph_grid* g, con
         for (ci = 0; ci < (sph__idx)nchunk; ++ci) {
             size_t need;
             if (fast && g->dim == 2)
-                need = sph__neighbors_chunk_dense(nl, g, x, xq, nq, radius, exclude_self, (size_t)ci, 2);
+                need = sph__neighbors_chunk_dense(nl, g, x, xq, nq, radius, exclude_self, (size_t)ci, near, 2);
             else if (fast && g->dim == 3)
-                need = sph__neighbors_chunk_dense(nl, g, x, xq, nq, radius, exclude_self, (size_t)ci, 3);
+                need = sph__neighbors_chunk_dense(nl, g, x, xq, nq, radius, exclude_self, (size_t)ci, near, 3);
             else if (fast)
-                need = sph__neighbors_chunk_dense(nl, g, x, xq, nq, radius, exclude_self, (size_t)ci, 1);
+                need = sph__neighbors_chunk_dense(nl, g, x, xq, nq, radius, exclude_self, (size_t)ci, near, 1);
             else
                 need = sph__neighbors_chunk(nl, g, x, order, xq, nq, radius, exclude_self, (size_t)ci);
             nl->chunk_need[ci] = need;
@@ -2642,6 +2653,54 @@ static sph_status sph__neighbors_build(sph_neighbors* nl, const sph_grid* g, con
         if (!sph__neighbors_room(nl)) break;
         SPH_ASSERT(pass == 0); /* the second pass has room for every chunk */
     }
+    return SPH_OK;
+}
+
+static sph_status sph__neighbors_build(sph_neighbors* nl, const sph_grid* g, const sph_real* x,
+                                       const uint32_t* order, const sph_real* xq, size_t nq,
+                                       sph_real radius, int exclude_self) {
+    return sph__neighbors_build_near(nl, g, x, order, xq, nq, radius, exclude_self, NULL);
+}
+
+/* For each cell of the dense table of g, whether a point of g lies in the 3^dim cells around it
+   (occupancy widened by a cell along x, y and z in turn), into *near (grown to the table; 1
+   byte a cell). A query point whose cell has none has no neighbours in g: the search then skips
+   its stencil (the fluid inside a tank against the walls' grid; 3D dam break, 59k fluid and
+   150k wall particles, 1 thread: the fluid's wall lists 4.9 -> 3.1 ms a step). *on: whether
+   the table was made (not for a hashed or periodic grid, whose every stencil is visited);
+   SPH_ERR_NOMEM when out of memory. */
+static sph_status sph__grid_near(const sph_grid* g, uint8_t** near, size_t* cap, int* on) {
+    const int64_t ex[3] = {g->ext[0], g->dim > 1 ? g->ext[1] : 1, g->dim > 2 ? g->ext[2] : 1};
+    const int64_t st[3] = {1, ex[0], ex[0] * ex[1]};
+    const int64_t nc = (int64_t)g->nbucket;
+    sph__idx l;
+    int k;
+    *on = 0;
+    if (g->hashed || g->periodic[0] || g->periodic[1] || g->periodic[2] || g->n == 0)
+        return SPH_OK;
+    if ((size_t)nc > *cap) {
+        const size_t c = (size_t)nc + (size_t)nc / 4 + 16;
+        if (!sph__grow((void**)near, c, 1)) return SPH_ERR_NOMEM;
+        *cap = c;
+    }
+    SPH__OMP_FOR(nc)
+    for (l = 0; l < (sph__idx)nc; ++l) (*near)[l] = (uint8_t)(g->start[l + 1] > g->start[l]);
+    for (k = 0; k < g->dim; ++k) {
+        const int64_t len = ex[k], stride = st[k], nline = nc / len;
+        uint8_t* nr = *near;
+        SPH__OMP_FOR(nline)
+        for (l = 0; l < (sph__idx)nline; ++l) { /* line l: every coordinate but k fixed */
+            uint8_t* c = nr + ((int64_t)l / stride) * stride * len + (int64_t)l % stride;
+            uint8_t prev = 0;
+            int64_t t;
+            for (t = 0; t < len; ++t, c += stride) {
+                const uint8_t cur = *c;
+                *c = (uint8_t)(prev | cur | (t + 1 < len ? c[stride] : 0));
+                prev = cur;
+            }
+        }
+    }
+    *on = 1;
     return SPH_OK;
 }
 
@@ -2750,6 +2809,36 @@ static sph_status sph__neighbors_filter(sph_neighbors* nl, const sph_neighbors* 
         if (!sph__neighbors_room(nl)) break;
         SPH_ASSERT(pass == 0); /* the second pass has room for every chunk */
     }
+    return SPH_OK;
+}
+
+/* The lists of the np points a set of lists src points at, read from the other side: point b's
+   list holds, in ascending order, every query point of src whose list holds b. A search of the
+   same pairs from b's side gives exactly these lists when the pair test is symmetric and the
+   searched points are in cell order (see sph__wall_lists_mirrored), so the walls' lists
+   (boundary->fluid) need no search of their own: their pairs are the fluid's wall lists'. A
+   counting sort by b, one pass over the pairs (serial, as the pairs are few: those at the
+   walls); idx keeps its room between calls. */
+static sph_status sph__neighbors_transpose(sph_neighbors* nl, const sph_neighbors* src, size_t np) {
+    const size_t total = src->total;
+    size_t i, kk, b, sum = 0;
+    if (!sph__neighbors_reserve(nl, np, (np + SPH__CHUNK - 1) / SPH__CHUNK))
+        return sph__neighbors_nomem(nl);
+    if (total > nl->cap_idx) {
+        const size_t cap = total + total / 4 + 16;
+        if (!sph__grow((void**)&nl->idx, cap, sizeof(uint32_t))) return sph__neighbors_nomem(nl);
+        nl->cap_idx = cap;
+    }
+    for (b = 0; b < np; ++b) nl->count[b] = 0;
+    for (i = 0; i < src->n; ++i)
+        for (kk = src->begin[i]; kk < src->begin[i] + src->count[i]; ++kk) ++nl->count[src->idx[kk]];
+    for (b = 0; b < np; ++b) { nl->begin[b] = sum; sum += nl->count[b]; nl->count[b] = 0; }
+    for (i = 0; i < src->n; ++i)
+        for (kk = src->begin[i]; kk < src->begin[i] + src->count[i]; ++kk) {
+            const uint32_t j = src->idx[kk];
+            nl->idx[nl->begin[j] + nl->count[j]++] = (uint32_t)i;
+        }
+    nl->total = total;
     return SPH_OK;
 }
 
@@ -3469,6 +3558,7 @@ SPHDEF void sph_world_free(sph_world* w) {
     for (k = 0; k < n; ++k) SPH_FREE(*arr[k].ptr);
     sph_grid_free(&w->priv.grid);
     sph_grid_free(&w->priv.bgrid);
+    SPH_FREE(w->priv.b_near);
     sph_neighbors_free(&w->priv.ff);
     sph_neighbors_free(&w->priv.fb);
     sph_neighbors_free(&w->priv.bf);
@@ -4101,7 +4191,7 @@ SPHDEF size_t sph_world_memory(const sph_world* w) {
     n = sph__boundary_arrays((sph_world*)w, arr);
     for (k = 0; k < n; ++k) bytes += w->b_capacity * arr[k].elem;
     bytes += sph__grid_memory(&w->priv.grid) + sph__grid_memory(&w->priv.bgrid) +
-             sph__grid_memory(&w->priv.sgrid);
+             sph__grid_memory(&w->priv.sgrid) + w->priv.b_near_cap;
     bytes += sph__neighbors_memory(&w->priv.ff) + sph__neighbors_memory(&w->priv.fb) +
              sph__neighbors_memory(&w->priv.bf) + sph__neighbors_memory(&w->priv.bb) +
              sph__neighbors_memory(&w->priv.snl) + sph__neighbors_memory(&w->priv.cff) +
@@ -4830,7 +4920,11 @@ static sph_status sph__sort_by_cell(sph_world* w, sph_real cell) {
     sph__permute(w, arr, narr, w->priv.grid.order, w->n);
     ++w->priv.sorts;
     if (w->nb > 0 && (w->priv.b_dirty || w->def.boundary_motion)) {
+        w->priv.b_near_on = 0;
         s = sph_grid_build(&w->priv.bgrid, w->b_x, w->nb);
+        if (s == SPH_OK)
+            s = sph__grid_near(&w->priv.bgrid, &w->priv.b_near, &w->priv.b_near_cap,
+                               &w->priv.b_near_on);
         if (s != SPH_OK) return sph__fail(w, s, -1, "boundary grid: %s", sph_status_string(s));
         narr = sph__boundary_arrays(w, arr);
         sph__permute(w, arr, narr, w->priv.bgrid.order, w->nb);
@@ -4845,13 +4939,30 @@ static sph_status sph__sort_by_cell(sph_world* w, sph_real cell) {
     return SPH_OK;
 }
 
+/* Whether the boundary->fluid lists may be read off the fluid->boundary ones
+   (sph__neighbors_transpose) instead of searched: without periodic directions the distance test
+   of a pair gives the same r^2 from either side (d and -d square alike, summed in the same
+   order), and the search of the fluid's dense grid (the fluid in cell order) lists a wall
+   particle's neighbours in ascending index, so the lists are the search's, pair for pair and in
+   order (tests/test_verlet.c, wall_lists_mirrored). The fluid's hashed grid (sparse fluid) lists
+   them in bucket order and is still searched. 3D IISPH dam break, 59k fluid and 150k wall
+   particles, 1 thread: the walls' lists 3.6 ms a step searched, 0.55 ms read off. */
+static int sph__wall_lists_mirrored(const sph_world* w) {
+    return !w->priv.grid.hashed && !w->priv.grid.periodic[0] && !w->priv.grid.periodic[1] &&
+           !w->priv.grid.periodic[2];
+}
+
 /* The lists fluid->fluid, fluid->boundary and boundary->fluid within r, from the sorted grids. */
 static sph_status sph__neighbors_lists(sph_world* w, sph_neighbors* ff, sph_neighbors* fb,
                                        sph_neighbors* bf, sph_real r) {
     sph_status s = sph__neighbors_build(ff, &w->priv.grid, w->x, NULL, w->x, w->n, r, 1);
     if (s == SPH_OK && w->nb > 0) {
-        s = sph__neighbors_build(fb, &w->priv.bgrid, w->b_x, NULL, w->x, w->n, r, 0);
-        if (s == SPH_OK) s = sph__neighbors_build(bf, &w->priv.grid, w->x, NULL, w->b_x, w->nb, r, 0);
+        s = sph__neighbors_build_near(fb, &w->priv.bgrid, w->b_x, NULL, w->x, w->n, r, 0,
+                                      w->priv.b_near_on ? w->priv.b_near : NULL);
+        if (s == SPH_OK)
+            s = sph__wall_lists_mirrored(w)
+                    ? sph__neighbors_transpose(bf, fb, w->nb)
+                    : sph__neighbors_build(bf, &w->priv.grid, w->x, NULL, w->b_x, w->nb, r, 0);
     }
     if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour lists: %s", sph_status_string(s));
     return SPH_OK;
@@ -4904,8 +5015,11 @@ static sph_status sph__verlet_restore(sph_world* w, sph_real rs) {
     int in_order = 1;
     if (w->priv.grid.cell != rs) sph__grid_recell(w, &w->priv.grid, rs);
     if (w->priv.bgrid.cell != rs) sph__grid_recell(w, &w->priv.bgrid, rs);
+    w->priv.b_near_on = 0;
     s = sph_grid_build(&w->priv.grid, vx, n);
     if (s == SPH_OK && nb > 0) s = sph_grid_build(&w->priv.bgrid, vbx, nb);
+    if (s == SPH_OK && nb > 0)
+        s = sph__grid_near(&w->priv.bgrid, &w->priv.b_near, &w->priv.b_near_cap, &w->priv.b_near_on);
     if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour grid: %s", sph_status_string(s));
     for (i = 0; i < n && in_order; ++i) in_order = w->priv.grid.order[i] == (uint32_t)i;
     for (i = 0; i < nb && in_order; ++i) in_order = w->priv.bgrid.order[i] == (uint32_t)i;
@@ -4918,9 +5032,12 @@ static sph_status sph__verlet_restore(sph_world* w, sph_real rs) {
         s = sph__neighbors_build(&w->priv.bb, &w->priv.bgrid, vbx, NULL, vbx, nb, rs, 1);
     if (s == SPH_OK) s = sph__neighbors_build(&w->priv.cff, &w->priv.grid, vx, NULL, vx, n, rs, 1);
     if (s == SPH_OK && nb > 0) {
-        s = sph__neighbors_build(&w->priv.cfb, &w->priv.bgrid, vbx, NULL, vx, n, rs, 0);
+        s = sph__neighbors_build_near(&w->priv.cfb, &w->priv.bgrid, vbx, NULL, vx, n, rs, 0,
+                                      w->priv.b_near_on ? w->priv.b_near : NULL);
         if (s == SPH_OK)
-            s = sph__neighbors_build(&w->priv.cbf, &w->priv.grid, vx, NULL, vbx, nb, rs, 0);
+            s = sph__wall_lists_mirrored(w)
+                    ? sph__neighbors_transpose(&w->priv.cbf, &w->priv.cfb, nb)
+                    : sph__neighbors_build(&w->priv.cbf, &w->priv.grid, vx, NULL, vbx, nb, rs, 0);
     }
     if (s != SPH_OK) return sph__fail(w, s, -1, "neighbour lists: %s", sph_status_string(s));
     w->priv.b_dirty = 0;

@@ -323,6 +323,94 @@ static void test_moving_walls(void) {
     sph_world_free(&b);
 }
 
+/* Lists a and b the same, list for list and pair for pair in order; the lists that differ. */
+static size_t lists_differ(const sph_neighbors* a, const sph_neighbors* b) {
+    size_t i, kk, bad = 0;
+    if (a->n != b->n || a->total != b->total) return a->n + 1;
+    for (i = 0; i < a->n; ++i) {
+        int same = a->count[i] == b->count[i];
+        for (kk = 0; same && kk < a->count[i]; ++kk)
+            same = a->idx[a->begin[i] + kk] == b->idx[b->begin[i] + kk];
+        bad += !same;
+    }
+    return bad;
+}
+
+/* A step's wall lists (fluid->boundary fb, boundary->fluid bf) against a search of their own:
+   the step reads bf off fb (sph__neighbors_transpose) and skips the fluid's stencils far from
+   any wall (sph__grid_near); both must give the search's lists exactly, in the same order, for
+   moving walls with Akinci volumes (IISPH, the 2D stirrer) and a 3D dam break's static box
+   (DFSPH, the automatic cubic kernel). The reference: grids on the positions of the step's
+   search (fluid by id from before the step, walls where the step left them), already in cell
+   order, so sph_neighbors_build lists in the step's order. */
+static size_t wall_lists_check(sph_world* w, int steps) {
+    const size_t D = (size_t)w->dim;
+    size_t bad = 0, i;
+    int s;
+    for (s = 0; s < steps; ++s) {
+        sph_real* xs = (sph_real*)malloc((w->n + 1) * D * sizeof(sph_real));
+        sph_real* bxs = (sph_real*)malloc((w->nb + 1) * D * sizeof(sph_real));
+        sph_real* xq = (sph_real*)malloc((w->n + 1) * D * sizeof(sph_real));
+        sph_real* bq = (sph_real*)malloc((w->nb + 1) * D * sizeof(sph_real));
+        sph_grid g, bg;
+        sph_neighbors fb, bf;
+        const sph_real R = w->kernel.radius;
+        memset(&fb, 0, sizeof fb);
+        memset(&bf, 0, sizeof bf);
+        positions_by_id(w, xs, bxs);
+        if (sph_step(w, sph_stable_dt(w, w->def.solver)) != SPH_OK) return 1000000;
+        for (i = 0; i < w->n; ++i) memcpy(xq + i * D, xs + (size_t)w->id[i] * D, D * sizeof(sph_real));
+        memcpy(bq, w->b_x, w->nb * D * sizeof(sph_real));
+        CHECK_EQ_INT(sph_grid_init(&g, w->dim, R, NULL, NULL, NULL), SPH_OK);
+        CHECK_EQ_INT(sph_grid_init(&bg, w->dim, R, NULL, NULL, NULL), SPH_OK);
+        CHECK_EQ_INT(sph_grid_build(&g, xq, w->n), SPH_OK);
+        CHECK_EQ_INT(sph_grid_build(&bg, bq, w->nb), SPH_OK);
+        for (i = 0; i < w->n; ++i) bad += g.order[i] != (uint32_t)i; /* the step's cell order */
+        for (i = 0; i < w->nb; ++i) bad += bg.order[i] != (uint32_t)i;
+        CHECK_EQ_INT(sph_neighbors_build(&fb, &bg, bq, xq, w->n, R, 0), SPH_OK);
+        CHECK_EQ_INT(sph_neighbors_build(&bf, &g, xq, bq, w->nb, R, 0), SPH_OK);
+        bad += lists_differ(&w->priv.fb, &fb) + lists_differ(&w->priv.bf, &bf);
+        CHECK(bf.total > 0);
+        sph_neighbors_free(&fb);
+        sph_neighbors_free(&bf);
+        sph_grid_free(&g);
+        sph_grid_free(&bg);
+        free(xs);
+        free(bxs);
+        free(xq);
+        free(bq);
+    }
+    return bad;
+}
+
+static void test_wall_lists_mirrored(void) {
+    sph_world w;
+    scene_stirrer st;
+    sph_world_def def = sph_world_def_default(2);
+    sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)0.3, (sph_real)0.3, (sph_real)0.3};
+    sph_real box[3] = {(sph_real)0.6, (sph_real)0.5, (sph_real)0.4};
+    sph_phase water;
+    st.omega = 2;
+    def.solver = SPH_SOLVER_IISPH;
+    CHECK(scene_stirrer_build(&w, def, 0.025, 0.5, &st) == SPH_OK);
+    CHECK(w.def.boundary_volume == SPH_BVOL_AKINCI && w.def.boundary_motion != NULL);
+    CHECK_EQ_INT(sph_advance(&w, (sph_real)0.05), SPH_OK);
+    CHECK_EQ_INT(wall_lists_check(&w, 4), 0);
+    sph_world_free(&w);
+    def = sph_world_def_default(3);
+    def.solver = SPH_SOLVER_DFSPH;
+    def.spacing = (sph_real)0.025;
+    memset(&water, 0, sizeof water);
+    water.rest_density = 1000;
+    CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
+    CHECK_EQ_INT(sph_fill_box(&w, sph_world_add_phase(&w, &water), lo, hi), SPH_OK);
+    CHECK_EQ_INT(sph_add_wall_box(&w, lo, box, 0, 0), SPH_OK);
+    CHECK_EQ_INT(sph_set_hydrostatic(&w), SPH_OK);
+    CHECK_EQ_INT(wall_lists_check(&w, 3), 0);
+    TH_NOTE("3D box: %zu fluid, %zu wall particles, %zu wall pairs", w.n, w.nb, w.priv.bf.total);
+    sph_world_free(&w);
+}
+
 /* The default (-1, automatic): WCSPH keeps its lists over several steps; DFSPH, whose steps
    move particles up to 0.4 dx, searches every step. */
 static void test_automatic_default(void) {
@@ -400,6 +488,7 @@ const th_test tests_verlet[] = {
     {"verlet/rebuild_after_rollback", test_rebuild_after_rollback},
     {"verlet/same_physics", test_same_physics},
     {"verlet/moving_walls", test_moving_walls},
+    {"verlet/wall_lists_mirrored", test_wall_lists_mirrored},
     {"verlet/automatic_default", test_automatic_default},
     {"verlet/threads_bitwise", test_threads},
     {"verlet/bad_skin", test_bad_skin},
