@@ -44,7 +44,7 @@ TEST_SRC = tests/main.c tests/impl.c tests/test_kernels.c tests/test_grid.c test
            tests/compile_second.c \
            tests/compile_static.c
 TEST_CXX = tests/compile_cpp.cpp
-TEST_DEP = sph.h tests/harness.h tests/alloc.h tests/state_hash.h tests/riemann.h bench/svg.h examples/scenes.h $(TEST_SRC) $(TEST_CXX)
+TEST_DEP = sph.h tests/harness.h tests/alloc.h tests/state_hash.h tests/riemann.h tests/tank_profile.h bench/svg.h examples/scenes.h $(TEST_SRC) $(TEST_CXX)
 EXAMPLES = hello first_scene dambreak paraview moving_boundary external_force multiphase float_build
 PREFIX  ?= /usr/local
 VTK_PYTHON ?= /usr/bin/python3

@@ -11,6 +11,7 @@
 #include "harness.h"
 #include "../sph.h"
 #include "../examples/scenes.h"
+#include "tank_profile.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -51,10 +52,10 @@ static df_tank run_df_tank(sph_solver solver, int dim, sph_boundary_pressure bp,
     sph_world_def def = sph_world_def_default(dim);
     sph_world w;
     df_tank r;
-    double *ps, bins[128] = {0}, dt, its = 0, itv = 0;
-    int *cn, bc[128] = {0}, b, nl = 0, np = 0;
+    tank_profile tp;
+    double *ps, dt, its = 0, itv = 0;
+    int* cn;
     size_t i;
-    const size_t D = (size_t)dim;
     memset(&r, 0, sizeof(r));
     def.solver = solver;
     def.boundary_pressure = bp;
@@ -94,26 +95,9 @@ static df_tank run_df_tank(sph_solver solver, int dim, sph_boundary_pressure bp,
         if (w.time > T - 0.3)
             for (i = 0; i < w.n; ++i) { ps[w.id[i]] += (double)w.p[i]; cn[w.id[i]]++; }
     }
-    for (i = 0; i < w.n; ++i) {
-        const sph_real* x = w.x + i * D;
-        const double y = (double)x[1], m = (double)w.kernel.radius;
-        double p, e;
-        int inner = !cn[w.id[i]] ? 0 : 1;
-        size_t k;
-        for (k = 0; k < D; ++k)
-            if (k != 1 && ((double)x[k] < m || (double)x[k] > W - m)) inner = 0;
-        if (!inner || y < m || y > H - m) continue;
-        p = ps[w.id[i]] / cn[w.id[i]];
-        e = (p - 1000 * 9.81 * (H - y)) / (1000 * 9.81 * H);
-        r.particle_err += fabs(e);
-        ++np;
-        b = (int)((y - m) / (2 * (double)w.dx)); /* layers two spacings thick */
-        if (b < 128) { bins[b] += e; bc[b]++; }
-    }
-    for (b = 0; b < 128; ++b)
-        if (bc[b]) { r.layer_err += fabs(bins[b] / bc[b]); ++nl; }
-    r.layer_err = nl ? r.layer_err / nl : 1;
-    r.particle_err = np ? r.particle_err / np : 1;
+    tp = tank_profile_error(&w, ps, cn, W, H, 1000, 9.81);
+    r.layer_err = tp.layer_err;
+    r.particle_err = tp.particle_err;
     r.iterations = r.steps ? its / r.steps : 0;
     r.divergence = r.steps ? itv / r.steps : 0;
     r.step_ms = r.steps ? 1e3 * w.step_time_total / r.steps : 0;
