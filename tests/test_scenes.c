@@ -499,7 +499,8 @@ static void test_tank_2d_comes_to_rest(void) {
 /* The pressure of a 3D tank at rest through sph_advance (scene_hydrostatic: 0.4 m square, water
    0.32 m deep, 16 particles over the depth, 3 s in 0.05 s frames), averaged per particle over
    the last 0.5 s and compared with rho g (H - y) a support away from the walls, the floor and
-   the surface (tests/tank_profile.h); bp -1: the solver's default walls. */
+   the surface (tests/tank_profile.h); every frame must succeed and leave no fluid particle past
+   the first wall layer. bp -1: the solver's default walls. */
 static tank_profile sc_tank_pressure(const sc_solver* so, int bp) {
     const double W = 0.4, H = 0.32, T = 3.0;
     sph_world_def def = sph_world_def_default(3);
@@ -507,7 +508,8 @@ static tank_profile sc_tank_pressure(const sc_solver* so, int bp) {
     tank_profile tp;
     double* ps;
     int *cn, f;
-    size_t i;
+    const int frames = (int)(T / 0.05 + 0.5);
+    size_t i, out = 0;
     memset(&tp, 0, sizeof tp);
     tp.layer_err = tp.particle_err = 1;
     if (so->pcisph >= 0) sph_world_def_pcisph(&def, so->pcisph);
@@ -519,14 +521,19 @@ static tank_profile sc_tank_pressure(const sc_solver* so, int bp) {
     }
     ps = (double*)calloc(w.n, sizeof(double));
     cn = (int*)calloc(w.n, sizeof(int));
-    for (f = 1; f <= (int)(T / 0.05 + 0.5); ++f) {
+    for (f = 1; f <= frames; ++f) {
         const sph_status s = sph_advance(&w, (sph_real)0.05);
         CHECK_MSG(s == SPH_OK, "%s %s: %s", so->name, sc_bp_name(bp), w.error);
         if (s != SPH_OK) break;
         if (w.time > T - 0.5 + 1e-9)
             for (i = 0; i < w.n; ++i) { ps[w.id[i]] += (double)w.p[i]; cn[w.id[i]]++; }
-        if (f == (int)(T / 0.05 + 0.5)) tp = tank_profile_error(&w, ps, cn, W, H, 1000, 9.81);
+        /* nothing past the first wall layer (half a spacing outside the tank's inner faces) */
+        for (i = 0; i < w.n * 3; ++i)
+            out += (double)w.x[i] < -0.5 * (double)w.dx ||
+                   ((i % 3) != 1 && (double)w.x[i] > W + 0.5 * (double)w.dx);
     }
+    CHECK_EQ_INT(out, 0);
+    if (f > frames) tp = tank_profile_error(&w, ps, cn, W, H, 1000, 9.81);
     TH_NOTE("%-11s %-11s 3D tank at rest, 16 particles deep: pressure error layers %.4f, "
             "particles %.4f of rho g H", so->name, sc_bp_name(bp), tp.layer_err, tp.particle_err);
     free(ps);

@@ -358,7 +358,13 @@ static size_t wall_lists_check(sph_world* w, int steps) {
         memset(&fb, 0, sizeof fb);
         memset(&bf, 0, sizeof bf);
         positions_by_id(w, xs, bxs);
-        if (sph_step(w, sph_stable_dt(w, w->def.solver)) != SPH_OK) return 1000000;
+        if (sph_step(w, sph_stable_dt(w, w->def.solver)) != SPH_OK) {
+            free(xs);
+            free(bxs);
+            free(xq);
+            free(bq);
+            return 1000000;
+        }
         for (i = 0; i < w->n; ++i) memcpy(xq + i * D, xs + (size_t)w->id[i] * D, D * sizeof(sph_real));
         memcpy(bq, w->b_x, w->nb * D * sizeof(sph_real));
         CHECK_EQ_INT(sph_grid_init(&g, w->dim, R, NULL, NULL, NULL), SPH_OK);
