@@ -664,6 +664,15 @@ static int suite_tts(const opts* o) {
                            : r->capped     ? "stopped at --max-wall"
                                            : "ok");
                     if (r->status) printf("          %s\n", r->error);
+                    if (r->time > 0) { /* where the time goes, per simulated second */
+                        static const char* const stage[SPH_STAGE_COUNT] = {
+                            "boundary", "neighbors", "density", "pressure", "forces", "integrate"};
+                        int k;
+                        printf("          s/sim-s by stage:");
+                        for (k = 0; k < SPH_STAGE_COUNT; ++k)
+                            printf(" %s %.3g", stage[k], r->stage_s[k] / r->time);
+                        printf("\n");
+                    }
                     fflush(stdout);
                     fprintf(f,
                             "%s,%s,%s,%d,%.0f,%.0f,%.4f,%.6f,%s,%.3f,%.6g,%d,%.0f,%.0f,%.6g,%.6g,"

@@ -535,6 +535,8 @@ BENCH_FN int BX(tts)(int scene, int solver, int quick, double t_end, double max_
         }
     }
     r->time = w.time;
+    for (f = 0; f < SPH_STAGE_COUNT; ++f)
+        r->stage_s[f] = (double)w.stage_time_total[f];
     if (r->frames > 0) {
         r->err_mean = sum_err / r->frames;
         r->comp_mean = sum_comp / r->frames;

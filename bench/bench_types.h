@@ -83,6 +83,7 @@ typedef struct tts_result {
     double its_mean;       /* mean over frame ends of the last sub-step's solver iterations     */
     double outside_max;    /* max over frame ends of the fluid particles outside the container  */
     double outside_depth;  /* the farthest any was outside it [particle spacings]               */
+    double stage_s[SPH_STAGE_COUNT]; /* wall-clock seconds per stage (w.stage_time_total)   */
     int frames;            /* frames completed                                                  */
     int status;            /* sph_status of the call that failed (0: none), -1: scene not built */
     int capped;            /* stopped by --max-wall                                             */
