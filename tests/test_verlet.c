@@ -417,6 +417,94 @@ static void test_wall_lists_mirrored(void) {
     sph_world_free(&w);
 }
 
+/* A step's fluid lists against a search of their own: the step searches each pair once (a half
+   search, the other half of each list read off it, sph__neighbors_build_self) on the dense grid
+   without periodic directions, and must give the whole search's lists exactly, pair for pair
+   and in order. Without a skin the step's ff (at the positions of its search, by id from before
+   the step, in the step's cell order); with one the candidates cff at their build positions
+   (w.priv.vl_x) and radius. Returns the lists that differ (and points out of cell order). */
+static size_t fluid_lists_check(sph_world* w, int steps) {
+    const size_t D = (size_t)w->dim;
+    size_t bad = 0, i;
+    int s;
+    for (s = 0; s < steps; ++s) {
+        sph_real* xs = (sph_real*)malloc((w->n + 1) * D * sizeof(sph_real));
+        sph_real* bxs = (sph_real*)malloc((w->nb + 1) * D * sizeof(sph_real));
+        sph_real* xq = (sph_real*)malloc((w->n + 1) * D * sizeof(sph_real));
+        const int skin = w->def.neighbor_skin > 0;
+        sph_real r;
+        sph_grid g;
+        sph_neighbors ff;
+        memset(&ff, 0, sizeof ff);
+        positions_by_id(w, xs, bxs);
+        if (sph_step(w, sph_stable_dt(w, w->def.solver)) != SPH_OK) bad += 1000000;
+        r = skin ? w->priv.vl_radius : w->kernel.radius;
+        if (skin) memcpy(xq, w->priv.vl_x, w->n * D * sizeof(sph_real));
+        else
+            for (i = 0; i < w->n; ++i)
+                memcpy(xq + i * D, xs + (size_t)w->id[i] * D, D * sizeof(sph_real));
+        CHECK_EQ_INT(sph_grid_init(&g, w->dim, r, NULL, NULL, NULL), SPH_OK);
+        CHECK_EQ_INT(sph_grid_build(&g, xq, w->n), SPH_OK);
+        for (i = 0; i < w->n; ++i) bad += g.order[i] != (uint32_t)i;
+        CHECK_EQ_INT(sph_neighbors_build(&ff, &g, xq, xq, w->n, r, 1), SPH_OK);
+        bad += lists_differ(skin ? &w->priv.cff : &w->priv.ff, &ff);
+        CHECK(ff.total > 0);
+        sph_neighbors_free(&ff);
+        sph_grid_free(&g);
+        free(xs);
+        free(bxs);
+        free(xq);
+    }
+    return bad;
+}
+
+/* The half search's lists on 1, 2 and 3 threads in turn (the unfolding runs in a part per
+   thread; 3 parts on 2 processors too): a 2D dam break under way searched every step (IISPH) and
+   with a skin (WCSPH, the candidates), a 3D box (DFSPH). Periodic grids are searched whole
+   (their lists are checked by lists_exact_periodic). */
+static void test_half_lists(void) {
+    int t, c;
+    for (c = 0; c < 3; ++c) {
+        sph_world w;
+        if (c < 2) {
+            sph_world_def def = sph_world_def_default(2);
+            def.solver = c ? SPH_SOLVER_WCSPH : SPH_SOLVER_IISPH;
+            def.neighbor_skin = c ? (sph_real)0.2 : 0;
+            def.domain_hi[0] = (sph_real)2.5;
+            def.domain_hi[1] = (sph_real)1.5;
+            CHECK(scene_dam_break(&w, def, 0.5, 40, NULL) == SPH_OK);
+            CHECK_EQ_INT(sph_advance(&w, (sph_real)0.05), SPH_OK); /* under way */
+        } else {
+            sph_world_def def = sph_world_def_default(3);
+            sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)0.3, (sph_real)0.3, (sph_real)0.3};
+            sph_real box[3] = {(sph_real)0.6, (sph_real)0.5, (sph_real)0.4};
+            sph_phase water;
+            def.solver = SPH_SOLVER_DFSPH;
+            def.spacing = (sph_real)0.02; /* 3375 particles: parts above 2048 */
+            memset(&water, 0, sizeof water);
+            water.rest_density = 1000;
+            CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
+            CHECK_EQ_INT(sph_fill_box(&w, sph_world_add_phase(&w, &water), lo, hi), SPH_OK);
+            CHECK_EQ_INT(sph_add_wall_box(&w, lo, box, 0, 0), SPH_OK);
+            CHECK_EQ_INT(sph_set_hydrostatic(&w), SPH_OK);
+        }
+        for (t = 1; t <= 3; ++t) {
+#ifdef _OPENMP
+            omp_set_num_threads(t);
+#else
+            if (t > 1) break;
+#endif
+            CHECK_EQ_INT(fluid_lists_check(&w, c == 1 ? 8 : 2), 0);
+        }
+#ifdef _OPENMP
+        omp_set_num_threads(omp_get_num_procs());
+#endif
+        TH_NOTE("%dD %s: %zu particles, %zu pairs", w.dim, c == 1 ? "skin 0.2 R" : "no skin", w.n,
+                c == 1 ? w.priv.cff.total : w.priv.ff.total);
+        sph_world_free(&w);
+    }
+}
+
 /* The default (-1, automatic): WCSPH keeps its lists over several steps; DFSPH, whose steps
    move particles up to 0.4 dx, searches every step. */
 static void test_automatic_default(void) {
@@ -495,6 +583,7 @@ const th_test tests_verlet[] = {
     {"verlet/same_physics", test_same_physics},
     {"verlet/moving_walls", test_moving_walls},
     {"verlet/wall_lists_mirrored", test_wall_lists_mirrored},
+    {"verlet/half_lists_match_search", test_half_lists},
     {"verlet/automatic_default", test_automatic_default},
     {"verlet/threads_bitwise", test_threads},
     {"verlet/bad_skin", test_bad_skin},
