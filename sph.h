@@ -5412,13 +5412,20 @@ SPH__INLINE sph_real sph__wall_kappa(const sph__ctx* c, size_t b, size_t i, sph_
     return c->bp_mode == SPH_BP_EXTRAPOLATE ? c->brho[b] : rhati;
 }
 
-/* m_i for one particle; D a compile-time constant (the pass is specialised per dimension, as
-   sph__stage_interact's are: the loop over k unrolls and d[] stays in registers). */
-SPH__INLINE sph_real sph__visc_norm_one(const sph__ctx* c, size_t i, const int D) {
+/* m_i for one particle; D and cached compile-time constants (the pass is specialised per
+   dimension, as sph__stage_interact's are: the loop over k unrolls and d[] stays in registers).
+   cached (the viscous pass is SPH__CACHED: IISPH, DFSPH): the density summation at these
+   positions kept every listed pair's grad W factor fw = norm_g F in c->ff_fw / fb_fw, so the
+   pair reads it instead of a square root and the kernel (3D IISPH at 59k particles, cubic
+   spline: the pass x2.7); otherwise (WCSPH, PCISPH) it evaluates F and multiplies by norm_g
+   once at the end. The two differ by rounding only. */
+SPH__INLINE sph_real sph__visc_norm_one(const sph__ctx* c, size_t i, const int D,
+                                        const int cached) {
     const sph_real* xi = c->x + i * (size_t)D;
     const sph_real rhati = c->rho[i] * c->pc[c->ph[i]].inv_rho0;
     const int per = c->periodic_any, form = c->k.form;
-    sph_real S = 0; /* sum_j V_j (-F_ij) r^4/(r^2 + eta^2) = d m_i, without the factor norm_g */
+    sph_real S = 0; /* sum_j V_j (-F_ij) r^4/(r^2 + eta^2) = d m_i, the factor norm_g in F when
+                       cached, else applied at the end */
     size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
     int k;
     for (kk = k0; kk < k1; ++kk) {
@@ -5427,7 +5434,8 @@ SPH__INLINE sph_real sph__visc_norm_one(const sph__ctx* c, size_t i, const int D
         sph_real d[3] = {0, 0, 0}, r2 = 0;
         sph__delta_vec_p(c, per, xi, c->x + j * (size_t)D, d, D);
         SPH__FOR_K(D, r2 += d[k] * d[k]);
-        S -= mj / c->rho[j] * sph__kf(form, sph__sqrt(r2) * c->k.inv_h) * r2 * r2 / (r2 + c->eta2);
+        S -= mj / c->rho[j] * (cached ? c->ff_fw[kk] : sph__kf(form, sph__sqrt(r2) * c->k.inv_h)) *
+             r2 * r2 / (r2 + c->eta2);
     }
     if (c->has_b) {
         k0 = c->fb->begin[i];
@@ -5438,21 +5446,26 @@ SPH__INLINE sph_real sph__visc_norm_one(const sph__ctx* c, size_t i, const int D
             sph__delta_vec_p(c, per, xi, c->bx + b * (size_t)D, d, D);
             SPH__FOR_K(D, r2 += d[k] * d[k]);
             S -= c->bvol[b] / sph__wall_kappa(c, b, i, rhati) *
-                 sph__kf(form, sph__sqrt(r2) * c->k.inv_h) * r2 * r2 / (r2 + c->eta2);
+                 (cached ? c->fb_fw[kk] : sph__kf(form, sph__sqrt(r2) * c->k.inv_h)) * r2 * r2 /
+                 (r2 + c->eta2);
         }
     }
-    return S * c->k.norm_g / (sph_real)D;
+    return (cached ? S : S * c->k.norm_g) / (sph_real)D;
 }
 
-static void sph__stage_visc_norm(sph_world* w, const sph__ctx* c) {
+/* [writes w->priv.lapc] cached: as sph__visc_norm_one's, the viscous pass's SPH__CACHED. */
+static void sph__stage_visc_norm(sph_world* w, const sph__ctx* c, int cached) {
     const int D = c->dim;
     sph__idx i;
     SPH_ASSERT(c->lapc && w->priv.lapc_cap >= w->n);
+    SPH_ASSERT(!cached || (c->ff_fw && (c->fb_fw || !c->has_b)));
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) {
-        const sph_real m = D == 2 ? sph__visc_norm_one(c, (size_t)i, 2)
-                         : D == 3 ? sph__visc_norm_one(c, (size_t)i, 3)
-                                  : sph__visc_norm_one(c, (size_t)i, 1);
+        const size_t q = (size_t)i;
+        const sph_real m =
+            D == 2   ? (cached ? sph__visc_norm_one(c, q, 2, 1) : sph__visc_norm_one(c, q, 2, 0))
+            : D == 3 ? (cached ? sph__visc_norm_one(c, q, 3, 1) : sph__visc_norm_one(c, q, 3, 0))
+                     : sph__visc_norm_one(c, q, 1, cached);
         w->priv.lapc[i] = m > SPH__R(0.5) ? 1 / m : 2;
     }
 }
@@ -5565,14 +5578,18 @@ SPH__INLINE sph_real sph__delta_across(const sph__ctx* c, const sph__phase_c* P,
 
 #define SPH__ROW 64 /* neighbours per batch of sph__accel_row */
 
-/* sph__interact_one's fluid pairs on the fast path (flags ACCEL, with or without STORE), in
-   batches of SPH__ROW neighbours: a gather loop reads each neighbour in list order, a packed
-   loop (SPH__VN lanes) does the square root, the kernel and the two divisions of the artificial
-   viscosity (branch-free: a receding pair's lane is masked to +0, and s - (+0) is s), and a
-   last loop adds the pair forces in list order. Every lane computes the plain loop's
-   expressions in the plain loop's order and the sums are taken in the same order, so the
-   result has the same bits. The packed loop replaces a branch on the sign of v_ij . x_ij that
-   went either way at random. [adds to ai, m/s^2] */
+/* sph__interact_one's fluid pairs on the fast path (viscous passes, with or without pressure,
+   STORE or CACHED), in batches of SPH__ROW neighbours: a gather loop reads each neighbour in
+   list order, a packed loop (SPH__VN lanes) does the square root and the kernel (or reads the
+   cached factor), the division of the laminar term and the two of the artificial viscosity
+   (branch-free: a receding pair's lane is masked to +0, and s - (+0) is s), and a last loop
+   adds the pair forces in list order. Every lane computes the plain loop's expressions in the
+   plain loop's order and the sums are taken in the same order, so the result has the same
+   bits. The packed loop replaces a branch on the sign of v_ij . x_ij that went either way at
+   random; for laminar viscosity it saves the plain loop's per-pair tests and halves the
+   divisions of its term (3D IISPH at 59k particles: the viscous pass, without the
+   normalisation, x1.45).
+   [adds to ai, m/s^2] */
 SPH__INLINE void sph__accel_row(const sph__ctx* c, size_t i, const int D, const int flags,
                                 sph_real* ai) {
     const sph_real* xi = c->x + i * (size_t)D;
@@ -5589,9 +5606,14 @@ SPH__INLINE void sph__accel_row(const sph__ctx* c, size_t i, const int D, const 
     const sph__v v_eta2 = sph__vset(c->eta2), v_ac = sph__vset(-c->alpha * cbar);
     const sph__v v_beta = sph__vset(c->beta), v_mj = sph__vset(mj), v_rhoi = sph__vset(rhoi);
     const int av = (flags & SPH__VISCOUS) && c->av;
-    sph_real dd[3][SPH__ROW], r2[SPH__ROW + SPH__VN], ud[SPH__ROW + SPH__VN];
+    /* laminar: the plain loop's lv = visc_k m_j (mu_i + mu_j)/rho_i / rho_j / (r^2 + eta^2),
+       its first factor the same for every pair of i; Morris' term along v_ij (lm), else in s */
+    const int lam = (flags & SPH__VISCOUS) && c->laminar, mor = lam && c->morris;
+    const sph__v v_lv0 = sph__vset(c->visc_k * mj * (P->mu + P->mu) * inv_rhoi);
+    const sph__v v_li = sph__vset(mor ? c->lapc[i] : 0);
+    sph_real dd[3][SPH__ROW], dv[3][SPH__ROW], r2[SPH__ROW + SPH__VN], ud[SPH__ROW + SPH__VN];
     sph_real pr[SPH__ROW + SPH__VN], rj[SPH__ROW + SPH__VN], fs[SPH__ROW + SPH__VN];
-    sph_real fwo[SPH__ROW + SPH__VN];
+    sph_real fwo[SPH__ROW + SPH__VN], lj[SPH__ROW + SPH__VN], lm[SPH__ROW + SPH__VN];
     size_t b0, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
     int k;
     for (b0 = k0; b0 < k1; b0 += SPH__ROW) {
@@ -5605,21 +5627,43 @@ SPH__INLINE void sph__accel_row(const sph__ctx* c, size_t i, const int D, const 
             SPH__FOR_K(D, d[k] = xi[k] - xj[k]; dd[k][m] = d[k]);
             SPH__FOR_K(D, rr += d[k] * d[k]);
             if (flags & SPH__VISCOUS) SPH__FOR_K(D, vd += (vi[k] - vj[k]) * d[k]);
+            if (mor) SPH__FOR_K(D, dv[k][m] = vi[k] - vj[k]);
             r2[m] = rr;
             ud[m] = vd;
             rj[m] = c->rho[j];
-            if (flags & SPH__PRESSURE) pr[m] = c->pr2c ? c->pr2c[j] : c->p[j] / (rj[m] * rj[m]);
+            if (mor) lj[m] = c->lapc[j];
+            if (flags & SPH__CACHED) fwo[m] = c->ff_fw[b0 + m];
+            if (flags & SPH__PRESSURE)
+                pr[m] = (flags & SPH__CACHED) ? c->pr2[j]
+                        : c->pr2c             ? c->pr2c[j]
+                                              : c->p[j] / (rj[m] * rj[m]);
         }
-        for (; m % SPH__VN; ++m) { r2[m] = far; ud[m] = 0; rj[m] = 1; pr[m] = 0; }
+        for (; m % SPH__VN; ++m) {
+            r2[m] = far; ud[m] = 0; rj[m] = 1; pr[m] = 0; lj[m] = 0; fwo[m] = 0;
+        }
         for (m = 0; m < nb; m += SPH__VN) {
             const sph__v vr2 = sph__vload(r2 + m);
-            const sph__v q = sph__vmul(sph__vsqrt(vr2), v_inv_h);
-            const sph__v t = sph__vsub(v_one, sph__vmul(v_half, q));
-            const sph__v t3 = sph__vmul(sph__vmul(sph__vmul(v_m5, t), t), t); /* -5 t^3 */
-            const sph__v kf = sph__vand(sph__vlt(q, v_two), t3); /* Wendland C2's f(q) */
-            const sph__v fw = sph__vmul(v_norm, kf);
-            sph__v sv = v_zero;
+            sph__v fw, sv = v_zero;
+            if (flags & SPH__CACHED) {
+                fw = sph__vload(fwo + m);
+            } else {
+                const sph__v q = sph__vmul(sph__vsqrt(vr2), v_inv_h);
+                const sph__v t = sph__vsub(v_one, sph__vmul(v_half, q));
+                const sph__v t3 = sph__vmul(sph__vmul(sph__vmul(v_m5, t), t), t); /* -5 t^3 */
+                const sph__v kf = sph__vand(sph__vlt(q, v_two), t3); /* Wendland C2's f(q) */
+                fw = sph__vmul(v_norm, kf);
+            }
             if (flags & SPH__PRESSURE) sv = sph__vmul(v_s0, sph__vadd(v_pi, sph__vload(pr + m)));
+            if (lam) {
+                const sph__v lv = sph__vdiv(sph__vdiv(v_lv0, sph__vload(rj + m)),
+                                            sph__vadd(vr2, v_eta2));
+                if (mor) /* lv fw r^2 (1/m_i + 1/m_j)/2, along v_ij */
+                    sph__vstore(lm + m, sph__vmul(sph__vmul(sph__vmul(sph__vmul(lv, fw), vr2),
+                                                            v_half),
+                                                  sph__vadd(v_li, sph__vload(lj + m))));
+                else
+                    sv = sph__vadd(sv, sph__vmul(lv, sph__vload(ud + m)));
+            }
             if (av) {
                 const sph__v u = sph__vload(ud + m);
                 const sph__v mu = sph__vdiv(sph__vmul(v_h, u), sph__vadd(vr2, v_eta2));
@@ -5630,10 +5674,11 @@ SPH__INLINE void sph__accel_row(const sph__ctx* c, size_t i, const int D, const 
                 sv = sph__vsub(sv, sph__vand(sph__vlt(u, v_zero), term));
             }
             sph__vstore(fs + m, sph__vmul(sv, fw));
-            sph__vstore(fwo + m, fw);
+            if (flags & SPH__STORE) sph__vstore(fwo + m, fw);
         }
         for (m = 0; m < nb; ++m) {
             if (flags & SPH__STORE) c->ff_fw_out[b0 + m] = fwo[m];
+            if (mor) SPH__FOR_K(D, ai[k] += lm[m] * dv[k][m]);
             SPH__FOR_K(D, ai[k] += fs[m] * dd[k][m]);
         }
     }
@@ -5643,14 +5688,14 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
                                    sph_real* acc, sph_real* rate, const int fast) {
     /* fast (a compile-time constant, see sph__stage_interact): the common configuration, known
        in advance, so the per-pair tests below fold away: one mass, no periodic direction, one
-       phase, the symmetric pressure gradient, no laminar viscosity, Wendland C2. The arithmetic
+       phase, the symmetric pressure gradient, Wendland C2 (or the cached factor). The arithmetic
        is the same expressions in the same order, so the results are bitwise those of the general
        path; only the branches and the kernel switch go (WCSPH 2D: forces and density rate x1.9). */
     const sph_real* const cm = fast ? NULL : c->m;
     const int form = fast ? (int)SPH__KF_WC2 : c->k.form;
     const int per = fast ? 0 : c->periodic_any;
     const int pgrad = fast ? (int)SPH_PGRAD_SYMMETRIC : c->pgrad;
-    const int laminar = fast ? 0 : c->laminar;
+    const int laminar = c->laminar;
     const sph_real* const cs = fast ? NULL : c->cs;
     const sph_real* const bpqa = fast ? NULL : c->bpq;
     const int en = (flags & SPH__ENERGY) != 0;
@@ -5667,7 +5712,7 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
     sph_real ai[3] = {0, 0, 0}, R = 0, E = 0;
     size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
     int k;
-    if (fast && (flags & SPH__ACCEL) && !(flags & (SPH__RATE | SPH__CACHED | SPH__ENERGY)))
+    if (fast && (flags & SPH__VISCOUS) && !(flags & (SPH__RATE | SPH__ENERGY)))
         sph__accel_row(c, i, D, flags, ai);
     else for (kk = k0; kk < k1; ++kk) {
         const size_t j = c->ff->idx[kk];
@@ -5732,7 +5777,9 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
             SPH__FOR_K(D, ai[k] += s * d[k]);
         }
     }
-    if (c->has_b) {
+    /* walls add a pressure, a rate (STORE comes with PRESSURE) or a no-slip viscous term; a
+       viscous pass against free-slip walls has none to add */
+    if (c->has_b && ((flags & (SPH__PRESSURE | SPH__RATE)) || (c->noslip && (laminar || c->av)))) {
         k0 = c->fb->begin[i];
         k1 = k0 + c->fb->count[i];
         for (kk = k0; kk < k1; ++kk) {
@@ -5818,17 +5865,17 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
    of pass, so each pass pays only for the terms it computes. */
 static void sph__stage_interact(sph_world* w, const sph__ctx* c, int flags, sph_real* acc) {
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
-    /* the configuration sph__interact_one's fast path assumes (see there); laminar viscosity
-       matters only to viscous passes, the kernel only to passes that evaluate it (the
-       incompressible solvers' cached pressure and rate passes take the fast path with both) */
+    /* the configuration sph__interact_one's fast path assumes (see there); the kernel matters
+       only to passes that evaluate it (the incompressible solvers' cached viscous, pressure and
+       rate passes take the fast path with any kernel) */
     const int fast = !c->m && !c->periodic_any && c->nphase == 1 && !c->bpq && !c->cs &&
                      c->pgrad == SPH_PGRAD_SYMMETRIC &&
-                     (!c->laminar || !(flags & SPH__VISCOUS)) &&
                      (c->k.form == SPH__KF_WC2 || (flags & SPH__CACHED)) &&
                      (c->dim == 2 || c->dim == 3);
     sph__idx blk;
     /* the Laplacian's normalisation at these positions (the energy pass reuses its force pass's) */
-    if ((flags & SPH__VISCOUS) && !(flags & SPH__ENERGY) && c->lapc) sph__stage_visc_norm(w, c);
+    if ((flags & SPH__VISCOUS) && !(flags & SPH__ENERGY) && c->lapc)
+        sph__stage_visc_norm(w, c, (flags & SPH__CACHED) != 0);
     SPH__OMP_FOR(w->n) /* over blocks of SPH__BLOCK particles */
     for (blk = 0; blk < (sph__idx)nblk; ++blk) {
         const size_t i0 = (size_t)blk * SPH__BLOCK;
