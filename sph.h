@@ -5755,7 +5755,11 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
     sph_real ai[3] = {0, 0, 0}, R = 0, E = 0;
     size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
     int k;
-    if (fast && (flags & SPH__VISCOUS) && !(flags & (SPH__RATE | SPH__ENERGY)))
+    /* the packed row: viscous passes (cached or not) and passes that evaluate the kernel
+       (PCISPH's pressure passes at predicted positions); a cached pressure-only pass has no
+       square root or division for it to pack */
+    if (fast && (flags & SPH__ACCEL) && !(flags & (SPH__RATE | SPH__ENERGY)) &&
+        ((flags & SPH__VISCOUS) || !(flags & SPH__CACHED)))
         sph__accel_row(c, i, D, flags, ai);
     else for (kk = k0; kk < k1; ++kk) {
         const size_t j = c->ff->idx[kk];
