@@ -2881,6 +2881,12 @@ static size_t sph__cell_order_lo(const sph_grid* g, const sph_real* x, size_t a,
     return lin > 0 ? (size_t)g->start[lin] : 0;
 }
 
+/* Narrows the half list hi[k0, k1) (ascending) to its points in the part [a, b). */
+SPH__INLINE void sph__half_in_part(const uint32_t* hi, size_t a, size_t b, size_t* k0, size_t* k1) {
+    while (*k0 < *k1 && hi[*k0] < a) ++*k0;
+    while (*k1 > *k0 && hi[*k1 - 1] >= b) --*k1;
+}
+
 /* The lists of a point set against itself (exclude_self) from one distance test a pair: on
    the dense path a half search keeps in `half` each point's neighbours after it (the later
    points of its own cell and those of the cells after it), and each list is then
@@ -2936,9 +2942,7 @@ static sph_status sph__neighbors_build_self(sph_neighbors* nl, sph_neighbors* ha
         for (h = a; h < b; ++h) cnt[h] = 0;
         for (h = sph__cell_order_lo(g, x, a, back); h < b; ++h) {
             size_t k0 = hb[h], k1 = k0 + hc[h];
-            /* the half lists ascend: those in the part, h's from a and before b */
-            while (k0 < k1 && hi[k0] < a) ++k0;
-            while (k1 > k0 && hi[k1 - 1] >= b) --k1;
+            sph__half_in_part(hi, a, b, &k0, &k1);
             for (kk = k0; kk < k1; ++kk) ++cnt[hi[kk]];
         }
     }
@@ -2970,8 +2974,7 @@ static sph_status sph__neighbors_build_self(sph_neighbors* nl, sph_neighbors* ha
                 for (kk = k0; kk < k1; ++kk) out[o++] = hi[kk];
                 at[h] = o;
             }
-            while (k0 < k1 && hi[k0] < a) ++k0;
-            while (k1 > k0 && hi[k1 - 1] >= b) --k1;
+            sph__half_in_part(hi, a, b, &k0, &k1);
             for (kk = k0; kk < k1; ++kk) out[at[hi[kk]]++] = (uint32_t)h;
         }
         /* each list's end back to its beginning */

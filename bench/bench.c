@@ -505,12 +505,14 @@ static int suite_model(const opts* o) {
     return 1;
 }
 
+/* Names of w.stats.stage_time's stages (enum sph_stage), for the suites that print them. */
+static const char* const stage_label[SPH_STAGE_COUNT] = {"boundary", "neighbors", "density",
+                                                        "pressure", "forces",    "integrate"};
+
 static int suite_run(const opts* o) {
     med_run m;
     bench_result r;
     int rep, k;
-    static const char* stage_names[6] = {"boundary", "neighbors", "density",
-                                         "pressure", "forces",    "integrate"};
     memset(&m, 0, sizeof m);
     set_threads(o->threads);
     for (rep = 0; rep < o->repeats; ++rep)
@@ -520,8 +522,8 @@ static int suite_run(const opts* o) {
            "%.1f iterations, %.1f pairs/particle, %.0f bytes/particle\n  stages (ms):",
            bench_scenes[o->scene].name, bench_solvers[o->solver].name, o->threads, r.n, r.nb,
            1e3 * r.step_s, r.n / r.step_s, r.iterations, r.pairs, r.bytes);
-    for (k = 0; k < 6; ++k)
-        printf(" %s %.3f", stage_names[k], 1e3 * r.stage_s[k]);
+    for (k = 0; k < SPH_STAGE_COUNT; ++k)
+        printf(" %s %.3f", stage_label[k], 1e3 * r.stage_s[k]);
     printf("\n");
     return 1;
 }
@@ -665,12 +667,10 @@ static int suite_tts(const opts* o) {
                                            : "ok");
                     if (r->status) printf("          %s\n", r->error);
                     if (r->time > 0) { /* where the time goes, per simulated second */
-                        static const char* const stage[SPH_STAGE_COUNT] = {
-                            "boundary", "neighbors", "density", "pressure", "forces", "integrate"};
                         int k;
                         printf("          s/sim-s by stage:");
                         for (k = 0; k < SPH_STAGE_COUNT; ++k)
-                            printf(" %s %.3g", stage[k], r->stage_s[k] / r->time);
+                            printf(" %s %.3g", stage_label[k], r->stage_s[k] / r->time);
                         printf("\n");
                     }
                     fflush(stdout);
