@@ -140,8 +140,9 @@ int main(void) {
    asks for c0 = 10 max(sqrt(2 |g| H), |v|max), chosen at the first step, so density varies by
    about 1 %. Density by continuity (default) with delta-SPH diffusion (Molteni & Colagrossi
    2009, delta = 0.1), by summation, or by Ott & Schnetter's particle-density continuity for
-   phases of very different density; negative pressures are clamped (no tension, def.clamp: see
-   sph__clamps for why, and sph__rho_floor for the least carried density). Phases: with particle
+   phases of very different density; negative pressures are clamped unless the domain is
+   periodic in every direction (no tension at a free surface, def.clamp: see sph__clamps for
+   why, and sph__rho_floor for the least carried density). Phases: with particle
    density, the multiphase (or interface) pressure gradient holds layers at rest (see PHASES),
    while SPH_PGRAD_DIFFERENCE lets buoyancy-driven interfaces move as they should (Rayleigh-Taylor
    growth within 7 % of the viscous theory at Atwood 0.5 and 0.29, where the antisymmetric forms
@@ -931,7 +932,7 @@ typedef enum sph_wall {
 } sph_wall;
 
 typedef enum sph_pressure_clamp {
-    SPH_CLAMP_AUTO = 0, /* WCSPH clamps; the compressible step with summation density (default)  */
+    SPH_CLAMP_AUTO = 0, /* clamp in WCSPH (not fully periodic) or with summation (default)      */
     SPH_CLAMP_ON,       /* p = max(p, 0): no tension (free surfaces without a background pressure) */
     SPH_CLAMP_OFF       /* negative pressures act as tension                                     */
 } sph_pressure_clamp;
@@ -1020,10 +1021,11 @@ typedef struct sph_world_def {
     sph_wcsph_scheme scheme;   /* default SPH_SCHEME_STANDARD                                     */
     int shift_every;           /* SPH_SCHEME_SECOND_ORDER: shift every this many steps (Negi &
                                   Ramachandran 2022: 10, the default); 0 = never; >= 0           */
-    sph_pressure_clamp clamp;  /* default SPH_CLAMP_AUTO: no tension in WCSPH (see sph__clamps:
-                                  a free surface's negative pressures clump the particles), and
-                                  in the compressible step with summation density. WCSPH and
-                                  compressible only: PCISPH and IISPH always clamp              */
+    sph_pressure_clamp clamp;  /* default SPH_CLAMP_AUTO: no tension in WCSPH unless the domain
+                                  is periodic in every direction (see sph__clamps: a free
+                                  surface's negative pressures clump the particles), and none
+                                  with summation density. WCSPH and compressible only: the
+                                  incompressible solvers always clamp                           */
     sph_real delta;            /* delta-SPH density diffusion coefficient [-]; default 0.1;
                                   [0, 1]. Acts in the continuity and particle density rates, not
                                   in IISPH or the second-order scheme                            */
@@ -4556,12 +4558,18 @@ static int sph__phase_walls(const sph_world* w) { return sph__phase_walls_for(w,
    Schnetter's particle density) falls towards sph__rho_floor's value where a particle leaves its
    neighbours, where the Tait equation's pressure tends to -B: that tension pulled a dam break's
    splash into clumps of ten particles on one point (0.4 x 0.6 m column in a closed 1.6 x 0.8 m
-   tank, dx 0.01: compressed 20 % at 2.22 s; clamped, it runs 6 s). The compressible step keeps
-   its tension (gases, and liquids under tension) unless asked. */
+   tank, dx 0.01: compressed 20 % at 2.22 s; clamped, it runs 6 s). A domain periodic in every
+   direction has no free surface, and there the pressure's negative part is the flow's own (a
+   Taylor-Green vortex without background pressure), so it keeps its tension. The compressible
+   step keeps its tension (gases, and liquids under tension) unless asked. */
 static int sph__clamps(const sph_world* w) {
+    int k, all_periodic = 1;
     if (w->priv.solver != SPH_SOLVER_WCSPH && w->priv.solver != SPH_SOLVER_COMPRESSIBLE) return 1;
     if (w->def.clamp != SPH_CLAMP_AUTO) return w->def.clamp == SPH_CLAMP_ON;
-    return w->priv.solver == SPH_SOLVER_WCSPH || w->def.density == SPH_DENSITY_SUMMATION;
+    if (w->def.density == SPH_DENSITY_SUMMATION) return 1;
+    for (k = 0; k < w->dim; ++k)
+        if (!w->def.periodic[k]) all_periodic = 0;
+    return w->priv.solver == SPH_SOLVER_WCSPH && !all_periodic;
 }
 
 static void sph__ctx_init(sph_world* w, sph__ctx* c) {
