@@ -347,7 +347,9 @@ int main(void) {
    from sinking until the wall supplies the volume it lacks, i.e. onto and past the wall's first
    layer. So the end of every step keeps each fluid centre at least wall_contact dx (0.73 in 2D,
    0.89 in 3D) from every boundary particle, moving it along the wall's normal and removing its
-   velocity into the wall (free slip, inelastic: it takes energy, never adds it). In 3D with zero
+   velocity into the wall (free slip, inelastic: it takes energy, never adds it); a carried
+   density (continuity, particle density) gains the compression that move makes, as a summation
+   density would (sph__contact_density). In 3D with zero
    wall pressure and PCISPH, IISPH or DFSPH that distance is for particles short of neighbours
    (fewer fluid and wall neighbours than 0.7 of a full lattice's) and ramps down to 0.6 dx for
    those with 0.85 and more: zero wall pressure rests those rows 0.5-0.65 dx from the wall's
@@ -1070,7 +1072,8 @@ typedef struct sph_world_def {
     sph_pressure_solve pressure_solve; /* IISPH: SPH_PSOLVE_JACOBI (default) or SPH_PSOLVE_CG (zero
                                   wall pressure only; Jacobi with the other schemes); max_iterations
                                   then counts products with A                                    */
-    sph_real warm_start;       /* iterative solvers: initial pressure = warm_start * last pressure;
+    sph_real warm_start;       /* iterative solvers: initial pressure = warm_start * last pressure
+                                  (PCISPH: times (dt_prev / dt)^2 when the step grows);
                                   0.5 (sph_world_def_pcisph: 0 for the original, 0.5 enhanced);
                                   [0, 1]                                                         */
     sph_real tolerance_max;    /* PCISPH: also stop only when the largest compression <= this;
@@ -1283,7 +1286,9 @@ typedef struct sph__private {
     size_t pr2_cap;
     sph_real* vol;                  /* WCSPH: m_i / rho_i (scratch)                               */
     size_t vol_cap;
-    sph_real* shift;                /* WCSPH with def.shifting: each particle's shift (scratch)   */
+    sph_real* shift;                /* each particle's displacement (scratch): WCSPH's shifting,
+                                       the wall contact's with a carried density
+                                       (sph__contact_density)                                    */
     size_t shift_cap;
     sph_real *xp, *vp;              /* PCISPH: predicted positions and velocities (scratch)         */
     size_t xp_cap, vp_cap;
@@ -4509,8 +4514,11 @@ typedef struct sph__ctx {
                                   average of the fluid's (solvers without one; Enhanced PCISPH
                                   2018 sec. 3.2.3)                                               */
     sph_real alpha, beta, delta, visc_k;
-    sph_real rho_alone;        /* W(0) / S: times m_i, the least density a particle can carry
-                                  (sph__rho_floor)                                               */
+    sph_real rho_alone;        /* W(0) / S: times m_i, the summation density of a particle
+                                  alone, the least a carried density keeps (sph__rho_floor,
+                                  sph__contact_density)                                          */
+    int rho_floor;             /* sph__rho_floor holds carried densities at m_i rho_alone (where
+                                  pressures are clamped, sph__clamps)                            */
     sph_real pg_norm;          /* 1 / the lattice gradient moment for the multiphase and interface
                                   pressure gradients (see sph__ctx_init), else 1                */
     sph_real* lapc;            /* laminar viscosity, Morris form: 1 / m_i per fluid particle
@@ -4588,7 +4596,8 @@ static void sph__ctx_init(sph_world* w, sph__ctx* c) {
     c->eta2 = SPH__R(0.01) * w->h * w->h;
     c->x = w->x; c->v = w->v; c->rho = w->rho; c->p = w->p; c->m = w->m;
     c->m0 = w->mass;
-    c->rho_alone = sph__clamps(w) ? w->kernel.norm_w * sph__kw(w->kernel.form, 0) / w->priv.lattice_sum : 0;
+    c->rho_alone = w->kernel.norm_w * sph__kw(w->kernel.form, 0) / w->priv.lattice_sum;
+    c->rho_floor = sph__clamps(w);
     c->ph = w->phase;
     c->bx = w->b_x; c->bv = w->b_v; c->bvw = w->b_vw; c->bvol = w->b_vol;
     c->bp = w->b_p; c->brho = w->b_rho;
@@ -6369,7 +6378,94 @@ static sph_status sph__energy_check(sph_world* w, double ke, double wrel) {
    Without the clamp a density below it is a blow-up, and is reported. */
 SPH__INLINE sph_real sph__rho_floor(const sph__ctx* c, size_t i, sph_real rho) {
     const sph_real lo = (c->m ? c->m[i] : c->m0) * c->rho_alone;
-    return rho < lo && lo > 0 ? lo : rho;
+    return c->rho_floor && rho < lo ? lo : rho;
+}
+
+/* Whether the step carries the density (the continuity equation or Ott & Schnetter's particle
+   density) instead of summing it from the positions each step: WCSPH, enhanced PCISPH and the
+   compressible step with def.density other than SPH_DENSITY_SUMMATION (IISPH, DFSPH and PBF
+   always sum). */
+static int sph__carries_density_for(const sph_world* w, int solver) {
+    return w->def.density != SPH_DENSITY_SUMMATION &&
+           (solver == SPH_SOLVER_WCSPH || solver == SPH_SOLVER_PCISPH || solver == SPH_SOLVER_COMPRESSIBLE);
+}
+
+/* The carried density of a wall contact's displacement. The contact and the crossing guard move a
+   particle by dx_i after its step's density rate was taken: a motion the continuity equation
+   never saw. A summation density sees it; a carried one must be told, or the displacement is a
+   compression no pressure answers. So the displacement is integrated as the continuity equation
+   (Monaghan 1992; Enhanced PCISPH 2018 eq. 3.2) integrates a velocity, exactly, as the change of
+   the kernel sums it makes:
+       rho_i += sum_j mu_j [W(x_i - x_j) - W(x_i - dx_i - x_j + dx_j)]
+              + sum_b psi_b [W(x_i - x_b) - W(x_i - dx_i - x_b)],
+   mu_j = m_j (m_i for the particle density), psi_b = rho0_i V_b (Akinci et al. 2012): the
+   moved particle and the fluid it was pushed into gain what their summation densities gain.
+   Why: the contact lifts a particle that the wall pressure did not stop (a sheet short of
+   neighbours runs along the floor) back to d_c from the wall, i.e. into the fluid above it, every
+   step, and that fluid's carried density never learned of it. Measured on a 2D dam break (0.4 x
+   0.6 m column, 1.6 x 0.8 m tank of Akinci-volume walls, dx 0.01, enhanced PCISPH): the floor
+   row's summation density rose to 1.6 times its carried density by t = 0.3 s (2 by 0.4 s;
+   without the contact and delta-SPH 1.000, with delta-SPH alone 1.03), the contact's unrecorded
+   displacements accounting for it (its share summed over the fluid +81 rho0 against -13 for
+   everything else), so PCISPH saw rest density where particles were paired at 0.001 dx and
+   piled into the bottom corner until one was compressed past max_compression at t = 1.18 s.
+   With it the ratio stays at delta-SPH's 1.03 and the run reaches 3 s. A decrease stops at the
+   density of a particle alone, m_i W(0) / S (the least a summation density can be): a splash
+   particle whose carried density the explicit step had already taken below that (the continuity
+   equation overshoots as a particle leaves its neighbours) was driven negative by it on a ramp
+   and failed the run. dx_i is in w->priv.shift (scratch, reserved by sph__step_begin; all
+   particles' before any density changes); the lists are the step's (the pairs its density rate used). */
+static void sph__contact_density(sph_world* w, const sph__ctx* c, const sph_real* sh) {
+    const int D = w->dim, os = w->def.density == SPH_DENSITY_PARTICLE;
+    sph__idx i;
+    SPH__OMP_FOR(w->n)
+    for (i = 0; i < (sph__idx)w->n; ++i) {
+        const sph_real* xi = w->x + (size_t)i * (size_t)D;
+        const sph_real* di = sh + (size_t)i * (size_t)D;
+        const sph_real mi = c->m ? c->m[i] : c->m0, rho0 = c->pc[w->phase[i]].rho0;
+        const int moved = di[0] != 0 || (D > 1 && di[1] != 0) || (D > 2 && di[2] != 0);
+        sph_real sum = 0;
+        size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
+        int k;
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t j = c->ff->idx[kk];
+            const sph_real* dj = sh + j * (size_t)D;
+            sph_real d[3] = {0, 0, 0}, r1 = 0, r0 = 0;
+            if (!moved && dj[0] == 0 && (D < 2 || dj[1] == 0) && (D < 3 || dj[2] == 0)) continue;
+            sph__delta_vec(c, xi, w->x + j * (size_t)D, d, D);
+            for (k = 0; k < D; ++k) {
+                const sph_real e = d[k] - di[k] + dj[k];
+                r1 += d[k] * d[k];
+                r0 += e * e;
+            }
+            sum += (os ? mi : (c->m ? c->m[j] : c->m0)) * (sph__kw(c->k.form, sph__sqrt(r1) * c->k.inv_h) -
+                                                           sph__kw(c->k.form, sph__sqrt(r0) * c->k.inv_h));
+        }
+        if (moved && c->has_b) {
+            k0 = c->fb->begin[i];
+            k1 = k0 + c->fb->count[i];
+            for (kk = k0; kk < k1; ++kk) {
+                const size_t b = c->fb->idx[kk];
+                sph_real d[3] = {0, 0, 0}, r1 = 0, r0 = 0;
+                sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
+                for (k = 0; k < D; ++k) {
+                    r1 += d[k] * d[k];
+                    r0 += (d[k] - di[k]) * (d[k] - di[k]);
+                }
+                sum += rho0 * c->bvol[b] * (sph__kw(c->k.form, sph__sqrt(r1) * c->k.inv_h) -
+                                            sph__kw(c->k.form, sph__sqrt(r0) * c->k.inv_h));
+            }
+        }
+        sum *= c->k.norm_w;
+        if (sum < 0) { /* no lower than a particle alone, m_i W(0) / S (a carried density below it
+                          stays where it is) */
+            const sph_real alone = mi * c->rho_alone;
+            const sph_real lo = w->rho[i] < alone ? w->rho[i] : alone;
+            w->rho[i] = w->rho[i] + sum > lo ? w->rho[i] + sum : lo;
+        } else {
+            w->rho[i] += sum;
+        }
+    }
 }
 
 static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph_real* acc,
@@ -6391,6 +6487,10 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
     const int ramp = D == 3 && sph__incompressible(w->priv.solver) &&
                      c->bp_mode == SPH_BP_ZERO && w->priv.full_count > 0;
     const sph_real inv_full = ramp ? 1 / (sph_real)w->priv.full_count : 0;
+    /* the contact's displacements, for a carried density (sph__contact_density; the scratch
+       comes from sph__step_begin) */
+    sph_real* sh = dc > 0 && sph__carries_density_for(w, w->priv.solver) &&
+                           w->priv.shift_cap >= w->n * (size_t)D ? w->priv.shift : NULL;
     sph__idx blk;
     size_t q;
     int k;
@@ -6469,6 +6569,7 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 }
             }
             if (!final) continue;
+            if (sh) for (kk = 0; kk < D; ++kk) sh[i * (size_t)D + (size_t)kk] = xi[kk];
             if (dc > 0 && c->fb->count[i] > 0) {
                 sph_real d = dc;
                 if (ramp) { /* from d_c short of neighbours down to 0.6 dx with a full set */
@@ -6484,6 +6585,8 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 else if (sph__wall_contact(c, i, d, xi, vi))
                     r[SPH__RED_CONTACT] += 1;
             }
+            if (sh) /* the contact's (and the guard's) displacement */
+                for (kk = 0; kk < D; ++kk) sh[i * (size_t)D + (size_t)kk] = xi[kk] - sh[i * (size_t)D + (size_t)kk];
             mi = (double)(w->m ? w->m[i] : w->mass);
             for (kk = 0; kk < D; ++kk) {
                 v2 += (double)vi[kk] * (double)vi[kk];
@@ -6545,6 +6648,19 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
             red[SPH__RED_BAD] = r[SPH__RED_BAD];
             red[SPH__RED_KIND] = r[SPH__RED_KIND];
         }
+    }
+    if (sh && red[SPH__RED_CONTACT] > 0) {
+        /* the contact's compression joins the carried density; a particle it compresses past
+           max_compression fails the step as any other (the first by index) */
+        sph__contact_density(w, c, sh);
+        if (red[SPH__RED_BAD] < 0 && w->def.max_compression > 0)
+            for (q = 0; q < w->n; ++q)
+                if (!c->pc[w->phase[q]].gas && (double)(w->rho[q] * c->pc[w->phase[q]].inv_rho0) - 1 >
+                                                   (double)w->def.max_compression) {
+                    red[SPH__RED_BAD] = (double)q;
+                    red[SPH__RED_KIND] = SPH__BAD_COMPRESSION;
+                    break;
+                }
     }
     w->stats.kinetic_energy = red[SPH__RED_KE];
     w->stats.density_error_avg = w->n ? red[SPH__RED_ERRSUM] / (double)w->n : 0;
@@ -6875,6 +6991,8 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
     if (s == SPH_OK && sph__phase_walls_for(w, (int)solver))
         s = sph__scratch(w, &w->priv.bpq, w->nb * (size_t)w->nphase * SPH__BPQ);
     if (s == SPH_OK && sph__visc_norm_used(w)) s = sph__scratch(w, &w->priv.lapc, w->capacity);
+    if (s == SPH_OK && w->def.wall_contact > 0 && w->nb > 0 && sph__carries_density_for(w, (int)solver))
+        s = sph__scratch(w, &w->priv.shift, w->capacity * (size_t)w->dim); /* sph__contact_density */
     if (s != SPH_OK) return s;
     s = sph__resolve_sound_speed(w);
     if (s != SPH_OK) {
@@ -7642,7 +7760,8 @@ SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt) {
      (e) Alg. 5 starts every step from p = 0: one step of gravity barely compresses the predicted
          state, so the loop stops with a fraction of the hydrostatic pressure and the fluid sags
          until a standing compression near the tolerance carries it (an underdamped, WCSPH-like
-         equilibrium). The enhanced preset warm-starts from half the last pressure, as IISPH;
+         equilibrium). The enhanced preset warm-starts from half the last pressure, as IISPH,
+         times (dt_prev / dt)^2 when the step grows (a correction's pressure scales as 1 / dt^2);
      (d) with Stormer-Verlet the positions drift half a step, the correction runs at the half step
          and constrains the density at the end of the step, predicted at x^{n+1/2} with the
          velocity beta v^n + (1 - beta) v*, beta = SPH__PCI_BETA = 0.47 (summation: at x^{n+1/2}
@@ -7752,7 +7871,7 @@ static void sph__stage_smooth_pressure(sph_world* w, const sph__ctx* c, sph_real
     sph__copy(w->p, w->priv.pr2, w->n * sizeof(sph_real));
 }
 
-static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
+static sph_status sph__step_pcisph(sph_world* w, sph_real dt, double dt_prev) {
     const int D = w->dim, verlet = w->def.integrator == SPH_INTEGRATOR_VERLET;
     const int summation = w->def.density == SPH_DENSITY_SUMMATION;
     const int per_particle = w->def.pcisph_factor == SPH_PCISPH_PER_PARTICLE;
@@ -7813,6 +7932,20 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
     if (w->nb > 0) sph__stage_wall(w, &c, SPH__WALL_STATE);
     if (c.laminar || c.av) sph__stage_interact(w, &c, SPH__VISCOUS, w->a);
     sph__time(w, SPH_STAGE_FORCES, &t0);
+    /* the warm start, (e) above: a pressure the last step built is a guess for this one only as
+       far as the steps match. The share that corrected a density error within the step scales
+       as 1 / dt^2 (as the gain does), so after a shorter step it is too large for a longer one:
+       a step that sph_advance or a caller shortened to land on a frame's end corrects its
+       standing compression with a pressure up to (dt / dt_short)^2 times the usual, and half of
+       it warm-started the next, full step, which overshot and diverged (tests/test_pcisph.c's
+       dam break at sph_stable_dt: after a step of 1/18 of the rule, 880 kPa at the base of a
+       0.1 m column, the next step's largest predicted density went 1.15, 1.39, 2.0, 6.6 rho0
+       in its first iterations, and the step failed). So the warm start is scaled by
+       (dt_prev / dt)^2 when the step grows (never up: a shorter step than the last starts from
+       at most warm_start of its pressure, as before) */
+    const sph_real warm = sph__warm(w) * (dt_prev > 0 && dt_prev < (double)dt
+                                              ? (sph_real)((dt_prev / (double)dt) * (dt_prev / (double)dt))
+                                              : 1);
     /* gains (the gradient's lattice normalisation pg_norm moves a particle that much further per
        pascal, so the gain is divided by it) */
     if (!(w->stats.gain_factor > 0) || w->stats.gain_factor > 1) w->stats.gain_factor = 1;
@@ -7838,7 +7971,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
             f = (sph_real)proto[w->phase[i]];
         }
         w->priv.aii[i] = f;
-        w->p[i] = w->p[i] > 0 ? sph__warm(w) * w->p[i] : 0; /* Alg. 5: warm_start = 0 */
+        w->p[i] = w->p[i] > 0 ? warm * w->p[i] : 0; /* Alg. 5: warm_start = 0 */
     }
     memset(w->priv.ap, 0, nD * sizeof(sph_real));
     keep = sph__standing_keep(w);
@@ -7984,9 +8117,10 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt) {
 }
 
 SPHDEF sph_status sph_step_pcisph(sph_world* w, sph_real dt) {
+    const double dt_prev = w ? w->stats.dt : 0; /* the last step's, before sph__step_begin sets it */
     sph_status s = sph__step_begin(w, dt, SPH_SOLVER_PCISPH);
     if (s != SPH_OK) return s;
-    return sph__step_end(w, sph__step_pcisph(w, dt));
+    return sph__step_end(w, sph__step_pcisph(w, dt, dt_prev));
 }
 
 /* ============================================================================================== */
