@@ -1333,6 +1333,7 @@ typedef struct sph__private {
                                        current sub-step's start [1] (rollback)                      */
     size_t snap_cap[2];             /* bytes                                                        */
     int cold_start;                 /* sph_advance's retry: pressure solves start from 0        */
+    double b_time;                  /* when def.boundary_motion last placed the walls [s]       */
     double dt_unpressed;            /* the original PCISPH: sph_stable_dt's step before its
                                        pressure rule (0: none), see sph__standing_keep          */
     double correct_fraction;        /* PCISPH, IISPH, DFSPH: the fraction of the compression
@@ -6139,6 +6140,7 @@ static sph_status sph__boundary_motion(sph_world* w, double t) {
     size_t i;
     if (!w->def.boundary_motion || w->nb == 0) return SPH_OK;
     w->def.boundary_motion(w, t, w->def.boundary_user);
+    w->priv.b_time = t;
     for (i = 0; i < w->nb * D; ++i)
         if (!sph__finite((double)w->b_x[i]) || !sph__finite((double)w->b_v[i]) ||
             !sph__finite((double)w->b_a[i]))
@@ -6230,9 +6232,27 @@ static sph_real sph__wall_fraction(const sph__ctx* c, const sph_real* xi, size_t
    holds no density (with zero wall pressure its floor row went through without the contact,
    tests/test_wcsph.c): there d_c applies to every particle. */
 #define SPH__CONTACT_REST 0.6
+/* x - x_b for the contact, with wall particle b where it will be at the step's end: moved walls
+   are placed once per step (at its start, or its middle), and the fluid ends the step lead =
+   t^{n+1} - t_walls later, so b is taken at x_b + lead v_b (lead = 0 for static walls). Against
+   the placed positions a rotating drum of one host-placed layer (2D, dx 0.01, 2 rad/s, IISPH)
+   carried its walls 0.11 dx per step into the particles the contact had just cleared, down to
+   0.62 dx, and pushed them through the diagonal gaps of the layer (1.41 dx, held only while
+   d_c > 0.71 dx): a particle escaped within 0.05 s. */
+SPH__INLINE void sph__wall_delta(const sph__ctx* c, const sph_real* x, size_t b, sph_real lead,
+                                 sph_real* d) {
+    const int D = c->dim;
+    int k;
+    sph__delta_vec(c, x, c->bx + b * (size_t)D, d, D);
+    if (lead != 0)
+        for (k = 0; k < D; ++k) d[k] -= lead * c->bv[b * (size_t)D + (size_t)k];
+}
+
 /* The wall's normal at x, n = -sum_b V_b grad W(x - x_b) (unnormalised: the wall volume
-   fraction's descent, pointing away from the wall's mass), over fluid particle i's wall list. */
-static void sph__wall_normal(const sph__ctx* c, size_t i, const sph_real* x, sph_real* g) {
+   fraction's descent, pointing away from the wall's mass), over fluid particle i's wall list,
+   with the walls at the step's end (sph__wall_delta). */
+static void sph__wall_normal(const sph__ctx* c, size_t i, const sph_real* x, sph_real lead,
+                             sph_real* g) {
     const int D = c->dim;
     const size_t k0 = c->fb->begin[i], k1 = k0 + c->fb->count[i];
     size_t kk;
@@ -6241,7 +6261,7 @@ static void sph__wall_normal(const sph__ctx* c, size_t i, const sph_real* x, sph
     for (kk = k0; kk < k1; ++kk) {
         const size_t b = c->fb->idx[kk];
         sph_real d[3] = {0, 0, 0}, r2 = 0, f;
-        sph__delta_vec(c, x, c->bx + b * (size_t)D, d, D);
+        sph__wall_delta(c, x, b, lead, d);
         for (k = 0; k < D; ++k) r2 += d[k] * d[k];
         f = c->bvol[b] * sph__kf(c->k.form, sph__sqrt(r2) * c->k.inv_h);
         for (k = 0; k < D; ++k) g[k] -= f * d[k];
@@ -6258,14 +6278,16 @@ static void sph__wall_normal(const sph__ctx* c, size_t i, const sph_real* x, sph
    normal (inelastic, as the contact). Measured: a block of water thrown at 10 m/s into the
    corner of a box of single-layer walls with Akinci volumes (2D, dx 0.02, IISPH) shot a
    particle through the corner at 37 m/s, which flew off unreported; with the guard none passes.
-   Returns 1 if it acted. */
+   A particle that creeps into the line of a layer or a gap between its particles is the
+   contact's (its first push follows the start's normal, sph__wall_contact). Returns 1 if it
+   acted. */
 #define SPH__CROSS_MOVE 0.4
 static int sph__wall_cross_guard(const sph__ctx* c, size_t i, const sph_real* xold,
-                                 const sph_real* gold, sph_real* xi, sph_real* vi) {
+                                 const sph_real* gold, sph_real lead, sph_real* xi, sph_real* vi) {
     const int D = c->dim;
     sph_real g[3], gg = 0, vn = 0, n2 = 0;
     int k;
-    sph__wall_normal(c, i, xi, g);
+    sph__wall_normal(c, i, xi, lead, g);
     for (k = 0; k < D; ++k) { gg += g[k] * gold[k]; n2 += gold[k] * gold[k]; }
     if (!(gg < 0) || !(n2 > 0)) return 0;
     n2 = 1 / sph__sqrt(n2);
@@ -6278,38 +6300,60 @@ static int sph__wall_cross_guard(const sph__ctx* c, size_t i, const sph_real* xo
     return 1;
 }
 
-static int sph__wall_contact(const sph__ctx* c, size_t i, sph_real dc, sph_real* xi, sph_real* vi) {
+/* One particle's contact: d [m] its distance (d_c, or less on the 3D ramp), the walls' lead at
+   the step's end and at the drift's start x_s (sph__wall_delta). The first push follows the
+   wall's normal at x_s, where the step found the particle on the fluid side, not the one at the
+   end: in the line of a single layer, and in the gaps between its particles, that one has no
+   side (a drum of one layer of lattice points, 2D, dx 0.01-0.02, turning at 2 rad/s: IISPH,
+   DFSPH and PBF particles crept into the diagonal gaps of its staircase, 1.41 dx, and the push
+   along the end's normal sent them out within 0.06-0.14 s; tests/test_scenes.c, drum_2d). Pushing
+   along the start's normal only where the end's turned against it let DFSPH and PBF out again.
+   A second pass, for a particle pushed onto another wall, follows the normal where it is. */
+static int sph__wall_contact(const sph__ctx* c, size_t i, sph_real dc, sph_real lead,
+                             const sph_real* xs, sph_real lead_s, sph_real* xi, sph_real* vi) {
     const int D = c->dim;
     const size_t k0 = c->fb->begin[i], k1 = k0 + c->fb->count[i];
     const sph_real dc2 = dc * dc;
     int pass, moved = 0;
     for (pass = 0; pass < 2; ++pass) { /* a second pass for a particle pushed onto another wall */
         sph_real g[3], n[3] = {0, 0, 0}, gn = 0, s = 0, vn = 0, r2min = dc2;
+        sph_real dn_near[3] = {0, 0, 0};
         size_t kk, near = k1;
         int k;
         for (kk = k0; kk < k1; ++kk) { /* the nearest wall particle within d_c, if any */
             sph_real d[3] = {0, 0, 0}, r2 = 0;
-            sph__delta_vec(c, xi, c->bx + c->fb->idx[kk] * (size_t)D, d, D);
+            sph__wall_delta(c, xi, c->fb->idx[kk], lead, d);
             for (k = 0; k < D; ++k) r2 += d[k] * d[k];
-            if (r2 < r2min) { r2min = r2; near = kk; }
+            if (r2 < r2min) {
+                r2min = r2;
+                near = kk;
+                for (k = 0; k < D; ++k) dn_near[k] = d[k];
+            }
         }
         if (near == k1) break; /* nothing within d_c: no kernel gradient needed */
-        sph__wall_normal(c, i, xi, g);
+        sph__wall_normal(c, i, xi, lead, g);
         for (k = 0; k < D; ++k) gn += g[k] * g[k];
+        if (pass == 0) { /* the start's normal where the end's turned from it by over 60 deg */
+            sph_real gs[3], dot = 0, gs2 = 0;
+            sph__wall_normal(c, i, xs, lead_s, gs);
+            for (k = 0; k < D; ++k) { dot += g[k] * gs[k]; gs2 += gs[k] * gs[k]; }
+            if (gs2 > 0 && !(dot > SPH__R(0.5) * sph__sqrt(gn * gs2))) {
+                for (k = 0; k < D; ++k) g[k] = gs[k];
+                gn = gs2;
+            }
+        }
         if (gn > 0) {
             gn = 1 / sph__sqrt(gn);
             for (k = 0; k < D; ++k) n[k] = g[k] * gn;
         } else { /* a symmetric spot (inside a thin wall): away from the nearest wall particle */
-            sph_real d[3] = {0, 0, 0}, r;
-            sph__delta_vec(c, xi, c->bx + c->fb->idx[near] * (size_t)D, d, D);
-            r = sph__sqrt(r2min);
+            const sph_real r = sph__sqrt(r2min);
             if (!(r > 0)) break; /* on a wall particle's centre: no direction (check_walls) */
-            for (k = 0; k < D; ++k) n[k] = d[k] / r;
+            for (k = 0; k < D; ++k) n[k] = dn_near[k] / r;
         }
         for (kk = k0; kk < k1; ++kk) {
             const size_t b = c->fb->idx[kk];
             sph_real d[3] = {0, 0, 0}, r2 = 0, dn = 0, sb;
-            sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
+            sph__wall_delta(c, xi, b, lead, d);
             for (k = 0; k < D; ++k) { r2 += d[k] * d[k]; dn += d[k] * n[k]; }
             if (!(r2 < dc2)) continue;
             sb = -dn + sph__sqrt(dn * dn - r2 + dc2); /* real: dc2 > r2 */
@@ -6485,6 +6529,8 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
     /* the contact distance [m] (sph__wall_contact), at the step's final drift, and whether it
        ramps down with the neighbour count (3D, zero wall pressure, incompressible solvers) */
     const sph_real dc = final && kx != 0 && c->has_b && w->nb > 0 ? w->def.wall_contact * w->dx : 0;
+    /* moved walls at the step's end (sph__wall_delta); the time has advanced already */
+    const sph_real lead = dc > 0 && w->def.boundary_motion ? (sph_real)(w->time - w->priv.b_time) : 0;
     const int ramp = D == 3 && sph__incompressible(w->priv.solver) &&
                      c->bp_mode == SPH_BP_ZERO && w->priv.full_count > 0;
     const sph_real inv_full = ramp ? 1 / (sph_real)w->priv.full_count : 0;
@@ -6553,11 +6599,13 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
             if (final && dc > 0 && c->fb->count[i] > 0) {
                 /* sph__wall_cross_guard: only a particle that moves far enough to cross */
                 sph_real m2 = 0;
-                for (kk = 0; kk < D; ++kk) m2 += kx * vi[kk] * kx * vi[kk];
+                for (kk = 0; kk < D; ++kk) {
+                    m2 += kx * vi[kk] * kx * vi[kk];
+                    xold[kk] = xi[kk]; /* where the drift starts (sph__wall_contact) */
+                }
                 if (m2 > SPH__R(SPH__CROSS_MOVE * SPH__CROSS_MOVE) * w->dx * w->dx) {
                     guard = 1;
-                    for (kk = 0; kk < D; ++kk) xold[kk] = xi[kk];
-                    sph__wall_normal(c, i, xi, gold);
+                    sph__wall_normal(c, i, xi, lead - kx, gold);
                 }
             }
             for (kk = 0; kk < D; ++kk) {
@@ -6581,9 +6629,9 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                     f = f < 0 ? 0 : f > 1 ? 1 : f;
                     d = d0 + f * (dc > d0 ? dc - d0 : 0);
                 }
-                if (guard && sph__wall_cross_guard(c, i, xold, gold, xi, vi))
+                if (guard && sph__wall_cross_guard(c, i, xold, gold, lead, xi, vi))
                     r[SPH__RED_CONTACT] += 1;
-                else if (sph__wall_contact(c, i, d, xi, vi))
+                else if (sph__wall_contact(c, i, d, lead, xold, lead - kx, xi, vi))
                     r[SPH__RED_CONTACT] += 1;
             }
             if (sh) /* the contact's (and the guard's) displacement */

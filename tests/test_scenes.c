@@ -13,7 +13,11 @@
      shell  the dam break in a box whose walls are one layer of boundary particles the host
             places on the box's faces (Akinci volumes), in 2D and 3D;
      jet    the shell's column thrown at 10 m/s against the far wall (a violent impact on
-            single-layer walls: corner jets three to four times as fast).
+            single-layer walls: corner jets three to four times as fast);
+     drum   a drum turning at 2 rad/s about its axis (the boundary-motion callback), a third
+            full, its wall one layer of the lattice points a host keeps in the band
+            R <= r < R + dx (a staircase with diagonal gaps of 1.41 dx; in 3D a cylinder with
+            single-layer end caps), Akinci volumes.
    Every run checks, frame by frame, that a failure is reported (a status with a message, the
    world as before the failing call), never silent. With each solver's default wall scheme
    (make test: short 2D and 3D variants; make validate: longer and finer) the run must get
@@ -37,9 +41,9 @@
 #define M_PI 3.14159265358979323846
 #endif
 
-typedef enum { SC_TANK, SC_DAM, SC_SLOSH, SC_BOX, SC_RING, SC_RING1, SC_SHELL, SC_JET } sc_scene;
-static const char* const sc_names[] = {"tank", "dam",   "slosh", "box",
-                                       "ring", "ring1", "shell", "jet"};
+typedef enum { SC_TANK, SC_DAM, SC_SLOSH, SC_BOX, SC_RING, SC_RING1, SC_SHELL, SC_JET, SC_DRUM } sc_scene;
+static const char* const sc_names[] = {"tank", "dam",   "slosh", "box", "ring",
+                                       "ring1", "shell", "jet",  "drum"};
 
 typedef struct sc_solver {
     const char* name;
@@ -85,6 +89,26 @@ static void sc_slosh_motion(sph_world* w, double t, void* user) {
     }
 }
 
+/* The drum: its axis through (R, R) along z, turning at sc_drum_omega [rad/s]. */
+static const double sc_drum_omega = 2.0;
+
+static void sc_drum_motion(sph_world* w, double t, void* user) {
+    const int D = w->dim;
+    const double R = *(const double*)user, c = cos(sc_drum_omega * t), s = sin(sc_drum_omega * t);
+    size_t b;
+    for (b = 0; b < w->nb; ++b) {
+        const size_t o = b * (size_t)D;
+        const double rx = (double)w->b_x0[o] - R, ry = (double)w->b_x0[o + 1] - R;
+        const double x = c * rx - s * ry, y = s * rx + c * ry;
+        w->b_x[o] = (sph_real)(R + x);
+        w->b_x[o + 1] = (sph_real)(R + y);
+        w->b_v[o] = (sph_real)(-sc_drum_omega * y);
+        w->b_v[o + 1] = (sph_real)(sc_drum_omega * x);
+        w->b_a[o] = (sph_real)(-sc_drum_omega * sc_drum_omega * x);
+        w->b_a[o + 1] = (sph_real)(-sc_drum_omega * sc_drum_omega * y);
+    }
+}
+
 /* Potential energy of the fluid in gravity [J]. */
 static double sc_potential(const sph_world* w) {
     double e = 0;
@@ -111,6 +135,10 @@ static size_t sc_escaped(const sph_world* w, sc_scene sc, const double* lo, cons
         if (sc == SC_RING || sc == SC_RING1) {
             const double dx0 = (double)x[0] - 0.5 * (lo[0] + hi[0]), dy = (double)x[1] - R;
             bad = sqrt(dx0 * dx0 + dy * dy) > R + tol;
+        } else if (sc == SC_DRUM) { /* past the band of the wall's centres, R + dx */
+            const double dx0 = (double)x[0] - R, dy = (double)x[1] - R;
+            bad = sqrt(dx0 * dx0 + dy * dy) > R + (double)w->dx + tol - 0.5 * (double)w->dx ||
+                  (D == 3 && ((double)x[2] < lo[2] - tol || (double)x[2] > hi[2] + tol));
         } else {
             for (k = 0; k < D; ++k)
                 if ((double)x[k] < lo[k] - tol || (double)x[k] > hi[k] + tol) bad = 1;
@@ -167,6 +195,40 @@ static sph_status sc_build_ring(sph_world* w, const sph_world_def* def, int ph, 
     return s;
 }
 
+/* The drum: the lattice points (spacing dx, offset half a spacing from the axis) in the band
+   R <= r < R + dx about (R, R), over the depth (0, depth) in 3D, and the lattice points of its
+   two end caps (one layer, half a spacing outside); the fluid on the same lattice inside
+   r < R - dx/2, below y = R - R/6. */
+static sph_status sc_build_drum(sph_world* w, int dim, int ph, double dx, double R, double depth) {
+    const int M = (int)(R / dx) + 2, nz = dim == 3 ? (int)(depth / dx + 0.5) : 1;
+    size_t cap = (size_t)(2 * M) * (size_t)(2 * M) * (size_t)(nz + 2), nb = 0, nf = 0;
+    sph_real* xb = (sph_real*)malloc(sizeof(sph_real) * 3 * cap);
+    sph_real* xf = (sph_real*)malloc(sizeof(sph_real) * 3 * cap);
+    sph_status s = SPH_ERR_NOMEM;
+    int i, j, k, q;
+    if (xb && xf) {
+        for (i = -M; i < M; ++i)
+            for (j = -M; j < M; ++j)
+                for (k = (dim == 3 ? -1 : 0); k <= (dim == 3 ? nz : 0); ++k) {
+                    const double x = (i + 0.5) * dx, y = (j + 0.5) * dx, r = hypot(x, y);
+                    const double p[3] = {R + x, R + y, (k + 0.5) * dx};
+                    const int cap_layer = dim == 3 && (k == -1 || k == nz);
+                    if (cap_layer ? r < R + dx : r >= R && r < R + dx) {
+                        for (q = 0; q < dim; ++q) xb[nb * (size_t)dim + (size_t)q] = (sph_real)p[q];
+                        ++nb;
+                    } else if (!cap_layer && r < R - 0.5 * dx && y < -R / 6) {
+                        for (q = 0; q < dim; ++q) xf[nf * (size_t)dim + (size_t)q] = (sph_real)p[q];
+                        ++nf;
+                    }
+                }
+        s = sph_add_boundary(w, nb, xb, NULL, 0);
+        if (s == SPH_OK) s = sph_add_fluid(w, ph, nf, xf, NULL);
+    }
+    free(xb);
+    free(xf);
+    return s;
+}
+
 /* One layer of boundary particles on the faces of the box [0, hi] (dim 2 or 3), half a spacing
    outside, edges and corners included: walls a host samples from a shape. */
 static sph_status sc_build_shell(sph_world* w, int dim, double dx, const double* hi) {
@@ -213,7 +275,12 @@ static sc_result sc_run(sc_scene sc, const sc_solver* so, int bp, int dim,
     if (bp >= 0) def.boundary_pressure = (sph_boundary_pressure)bp;
     def.spacing = (sph_real)dx;
     if (sc == SC_SLOSH) def.boundary_motion = sc_slosh_motion;
-    if (sc == SC_RING1 || sc == SC_SHELL || sc == SC_JET) def.boundary_volume = SPH_BVOL_AKINCI;
+    if (sc == SC_DRUM) {
+        def.boundary_motion = sc_drum_motion;
+        def.boundary_user = &R;
+    }
+    if (sc == SC_RING1 || sc == SC_SHELL || sc == SC_JET || sc == SC_DRUM)
+        def.boundary_volume = SPH_BVOL_AKINCI;
     if (sc == SC_BOX) {
         for (k = 0; k < 3; ++k) def.gravity[k] = 0;
         water.viscosity = (sph_real)0.01;
@@ -231,9 +298,12 @@ static sc_result sc_run(sc_scene sc, const sc_solver* so, int bp, int dim,
     case SC_BOX: H = hi[1]; break;
     case SC_RING:
     case SC_RING1: R = 0.5 * hi[0]; H = 1.2 * R; break;
+    case SC_DRUM: R = 0.3; H = 0.5 * R; hi[2] = 0.2; break;
     }
     if (sc == SC_RING || sc == SC_RING1) {
         CHECK_EQ_INT(sc_build_ring(&w, &def, ph, R, sc == SC_RING ? 3 : 1), SPH_OK);
+    } else if (sc == SC_DRUM) {
+        CHECK_EQ_INT(sc_build_drum(&w, dim, ph, dx, R, hi[2]), SPH_OK);
     } else if (sc == SC_SHELL || sc == SC_JET) {
         CHECK_EQ_INT(sph_fill_box(&w, ph, flo, fhi), SPH_OK);
         CHECK_EQ_INT(sc_build_shell(&w, dim, dx, hi), SPH_OK);
@@ -283,7 +353,7 @@ static sc_result sc_run(sc_scene sc, const sc_solver* so, int bp, int dim,
         }
         t_prev = w.time;
         e = w.stats.kinetic_energy + (sc == SC_BOX ? 0 : sc_potential(&w));
-        if (sc != SC_SLOSH) { /* no forcing: the energy must not rise */
+        if (sc != SC_SLOSH && sc != SC_DRUM) { /* no forcing: the energy must not rise */
             const double rise = sc == SC_BOX ? (w.stats.kinetic_energy - ke_prev) / escale
                                              : (e - e0) / escale;
             if (rise > r.e_rise) r.e_rise = rise;
@@ -346,7 +416,7 @@ static void sc_defaults(sc_scene sc, int dim, double dx, double duration) {
         CHECK_EQ_INT(r.escaped, 0);
         CHECK_LE(r.mass_err, 1e-12);
         if (sc == SC_BOX) CHECK_LE(r.e_rise, 1e-3);
-        else if (sc != SC_SLOSH) CHECK_LE(r.e_rise, 5e-3);
+        else if (sc != SC_SLOSH && sc != SC_DRUM) CHECK_LE(r.e_rise, 5e-3);
     }
 }
 
@@ -418,6 +488,14 @@ static void test_shell_3d(void) { sc_defaults(SC_SHELL, 3, 0.04, 0.5); }
    at 37 m/s, unreported, before sph__wall_cross_guard (2D, dx 0.02) */
 static void test_jet_2d(void) { sc_defaults(SC_JET, 2, 0.02, 0.5); }
 static void test_jet_3d(void) { sc_defaults(SC_JET, 3, 0.04, 0.3); }
+/* a turning drum of one host-sampled layer: IISPH, DFSPH and PBF put a particle through a
+   diagonal gap of its staircase within 0.08 s (dx 0.02), unreported: the contact took the walls
+   where the step began, not where it ends, and pushed along the wall's normal at the particle's
+   end, which has no side in the line of a single layer (sph__wall_contact). The same drum in 3D
+   (dx 0.04, 0.2 m deep, single-layer end caps) still lets IISPH (and PBF with given volumes)
+   through within 0.2-0.9 s: the 3D contact's ramp to 0.6 dx (zero wall pressure) leaves the
+   hollows of a layer open (README, "Walls of one layer") */
+static void test_drum_2d(void) { sc_defaults(SC_DRUM, 2, 0.02, 0.5); }
 static void test_tank_3d(void) { sc_defaults(SC_TANK, 3, 0.04, 0.5); }
 static void test_box_3d(void) { sc_defaults(SC_BOX, 3, 0.05, 0.3); }
 static void test_dam_3d(void) { sc_defaults(SC_DAM, 3, 0.025, 0.3); }
@@ -659,6 +737,7 @@ const th_test tests_scenes[] = {{"scenes/tank_2d", test_tank_2d}, {"scenes/tank_
                                 {"scenes/shell_3d", test_shell_3d},
                                 {"scenes/jet_2d", test_jet_2d},
                                 {"scenes/jet_3d", test_jet_3d},
+                                {"scenes/drum_2d", test_drum_2d},
                                 {"scenes/box_schemes_2d", test_box_schemes_2d},
                                 {"scenes/box_schemes_3d", test_box_schemes_3d}, {0, 0}};
 const th_test tests_scenes_long[] = {{"long/scenes/tank_2d", test_tank_2d_long},
