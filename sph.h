@@ -351,10 +351,11 @@ int main(void) {
    density (continuity, particle density) gains the compression that move makes, as a summation
    density would (sph__contact_density). In 3D with zero
    wall pressure and PCISPH, IISPH or DFSPH that distance is for particles short of neighbours
-   (fewer fluid and wall neighbours than 0.7 of a full lattice's) and ramps down to 0.6 dx for
-   those with 0.85 and more: zero wall pressure rests those rows 0.5-0.65 dx from the wall's
-   first layer, and a contact that fought them kept a 3D tank at rest moving at 0.2 sqrt(g H)
-   (see sph__wall_contact). Measured on
+   (fewer fluid and wall neighbours than 0.7 of a full lattice's) and ramps down to 0.6 dx, from
+   the nearest wall particle only, for those with 0.85 and more: zero wall pressure rests those
+   rows 0.5-0.65 dx from the wall's first layer, and a contact that fought them kept a 3D tank at
+   rest moving at 0.2 sqrt(g H) (see sph__wall_contact). Moving walls are taken where the step
+   ends. Measured on
    the 3D dam break at dx 0.05 (./build/bench tts --scene 3d-6k): fluid particles outside the
    container at a frame end, most at once, 390 -> 0 (WCSPH), 904 -> 0 (IISPH), 915 -> 0 (DFSPH);
    a one-particle sheet dropped on a host-placed floor (tests/test_reliability.c) sinks 0.67 dx
@@ -1323,6 +1324,12 @@ typedef struct sph__private {
     size_t full_count;              /* neighbours of a particle inside a full square lattice      */
     sph_real contact_short, contact_full; /* the wall contact's ramp, fractions of full_count
                                        (sph__contact_ramp)                                       */
+    double thin_sum;                /* a wall particle whose kernel sum over its wall neighbours
+                                       (itself included) is below this is in a thin wall: midway
+                                       between a lattice plane's and a half space's (3D)         */
+    uint8_t* b_thin;                /* [nb] 3D incompressible solvers: 1 for a wall particle of a
+                                       thin wall (sph__wall_thin), else 0                        */
+    int b_thin_on;                  /* b_thin holds the walls' present order                    */
     sph_real wall_fraction_max;     /* check_walls: wall volume fraction of a particle on the
                                        first layer of a flat lattice wall                          */
     sph_real tank_lo[3], tank_hi[3]; /* check_walls: the inner faces of the closed box of
@@ -3607,6 +3614,19 @@ static void sph__contact_ramp(sph_world* w) {
                 }
         }
     if (!(full > 0)) full = 1;
+    { /* sph__wall_thin: a lattice plane's kernel sum and a half space's (the plane included) */
+        double plane = 0, half = 0;
+        for (i = -M; i <= M; ++i)
+            for (k = -M; k <= M; ++k)
+                for (j = -M; j <= 0; ++j) {
+                    const double q = sqrt((double)(i * i + j * j + k * k)) * (double)w->dx /
+                                     (double)w->kernel.h;
+                    const double kw = (double)sph__kw(w->kernel.form, (sph_real)q);
+                    half += kw;
+                    if (j == 0) plane += kw;
+                }
+        w->priv.thin_sum = 0.5 * (plane + half);
+    }
     w->priv.contact_full = (sph_real)(top / full + 0.04);
     w->priv.contact_short = (sph_real)fmin(sheet / full + 0.15, top / full + 0.04 - 0.15);
 }
@@ -3794,6 +3814,7 @@ static int sph__boundary_arrays(sph_world* w, sph__array* a) {
     a[n].ptr = (void**)&w->b_rho; a[n].elem = r; a[n++].persistent = 0;
     a[n].ptr = (void**)&w->b_vw; a[n].elem = vec; a[n++].persistent = 0;
     a[n].ptr = (void**)&w->priv.b_sw; a[n].elem = r; a[n++].persistent = 0;
+    a[n].ptr = (void**)&w->priv.b_thin; a[n].elem = sizeof(uint8_t); a[n++].persistent = 0;
     return n;
 }
 
@@ -5035,6 +5056,44 @@ static sph_status sph__stage_boundary_volume(sph_world* w, sph_real radius, int 
     return SPH_OK;
 }
 
+/* Which wall particles form a thin wall (one layer, as a host samples a surface): those whose
+   kernel sum over their wall neighbours (themselves included) lies below midway between a
+   lattice plane's and a half space's (priv.thin_sum). The 3D wall contact keeps the ramp's
+   shorter distance (zero wall pressure's resting rows) for a thick wall only; at a thin one
+   every wall particle but the nearest keeps d_c, which closes the layer's hollows and gaps
+   (sph__wall_contact). Static walls: once; moved walls: at every sort, with the lists the
+   Akinci volumes use (searched here when those are not). Only where the ramp applies (3D, the
+   incompressible solvers). */
+static int sph__incompressible(int solver);
+static sph_status sph__wall_thin(sph_world* w, sph_real radius, int search) {
+    const int D = w->dim;
+    const double w0 = (double)sph__kw(w->kernel.form, 0);
+    sph__idx b;
+    if (search) {
+        sph_status s = sph__neighbors_build(&w->priv.bb, &w->priv.bgrid, w->b_x, NULL, w->b_x,
+                                            w->nb, radius, 1);
+        if (s != SPH_OK)
+            return sph__fail(w, s, -1, "boundary neighbour lists: %s", sph_status_string(s));
+    }
+    SPH__OMP_FOR(w->nb)
+    for (b = 0; b < (sph__idx)w->nb; ++b) {
+        const sph_neighbors* nl = &w->priv.bb;
+        size_t kk, k0 = nl->begin[b], k1 = k0 + nl->count[b];
+        double sum = w0;
+        for (kk = k0; kk < k1; ++kk) {
+            sph_real d[3] = {0, 0, 0}, r2 = 0;
+            int k;
+            sph_grid_delta(&w->priv.bgrid, w->b_x + (size_t)b * (size_t)D,
+                           w->b_x + nl->idx[kk] * (size_t)D, d);
+            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+            sum += (double)sph__kw(w->kernel.form, sph__sqrt(r2) * w->kernel.inv_h);
+        }
+        w->priv.b_thin[b] = (uint8_t)(sum < w->priv.thin_sum);
+    }
+    w->priv.b_thin_on = 1;
+    return SPH_OK;
+}
+
 /* A grid's cells made `cell` wide, its arrays kept (the periodic box from w.def, as at
    sph_world_init). The cell must leave two cells along a periodic direction. */
 static void sph__grid_recell(sph_world* w, sph_grid* g, sph_real cell) {
@@ -5148,8 +5207,13 @@ static sph_status sph__sort_by_cell(sph_world* w, sph_real cell) {
         if (s != SPH_OK) return sph__fail(w, s, -1, "boundary grid: %s", sph_status_string(s));
         narr = sph__boundary_arrays(w, arr);
         sph__permute(w, arr, narr, w->priv.bgrid.order, w->nb);
+        w->priv.b_thin_on = 0;
         if (w->def.boundary_volume == SPH_BVOL_AKINCI) {
             s = sph__stage_boundary_volume(w, cell, 1);
+            if (s != SPH_OK) return s;
+        }
+        if (w->dim == 3 && sph__incompressible(w->def.solver)) {
+            s = sph__wall_thin(w, cell, w->def.boundary_volume != SPH_BVOL_AKINCI);
             if (s != SPH_OK) return s;
         }
         /* only now: out of memory for the Akinci volumes must leave the walls dirty, or static
@@ -6211,9 +6275,10 @@ static sph_real sph__wall_fraction(const sph__ctx* c, const sph_real* xi, size_t
    lattice neighbourhood (0.85 for Wendland C2 at h = 1.3 dx, from the kernel's lattice by
    sph__contact_ramp; the count sph__enclosed uses) has the wall supply only what a fluid
    would, so the pressure solve, which holds its density, holds it, and its contact distance is
-   SPH__CONTACT_REST dx (over a wall particle its centre stays 0.1 dx on the fluid side of the
-   wall's face; over the hollow between wall particles it is free to reach the face, where zero
-   wall pressure's resting rows sit, +-0.04 dx); the distance grows linearly to d_c as the count
+   SPH__CONTACT_REST dx from its nearest wall particle and d_c from the others (over a wall
+   particle its centre stays 0.1 dx on the fluid side of the wall's face; over the hollow between
+   wall particles 0.03 dx, where zero wall pressure's resting rows sit, +-0.04 dx; see
+   sph__wall_contact for why the others keep d_c); the distance grows linearly to d_c as the count
    falls to a fraction "short" (0.7) of a full set (a switch instead
    of the ramp moved a particle 0.4 dx in one step whenever its count crossed the line, and its
    neighbours answered at 0.1-0.14 sqrt(g H)). Why: zero wall pressure's resting state is not the
@@ -6279,7 +6344,7 @@ static void sph__wall_normal(const sph__ctx* c, size_t i, const sph_real* x, sph
    corner of a box of single-layer walls with Akinci volumes (2D, dx 0.02, IISPH) shot a
    particle through the corner at 37 m/s, which flew off unreported; with the guard none passes.
    A particle that creeps into the line of a layer or a gap between its particles is the
-   contact's (its first push follows the start's normal, sph__wall_contact). Returns 1 if it
+   contact's (its first push may follow the start's normal, sph__wall_contact). Returns 1 if it
    acted. */
 #define SPH__CROSS_MOVE 0.4
 static int sph__wall_cross_guard(const sph__ctx* c, size_t i, const sph_real* xold,
@@ -6300,48 +6365,77 @@ static int sph__wall_cross_guard(const sph__ctx* c, size_t i, const sph_real* xo
     return 1;
 }
 
-/* One particle's contact: d [m] its distance (d_c, or less on the 3D ramp), the walls' lead at
-   the step's end and at the drift's start x_s (sph__wall_delta). The push follows the wall's
-   normal at the end, unless that turned more than 60 degrees from the normal at x_s, where the
-   step found the particle on the fluid side: in the line of a single layer, and in the gaps
-   between its particles, the end's normal has no side (a drum of one layer of lattice points,
-   2D, dx 0.01-0.02, turning at 2 rad/s: IISPH, DFSPH and PBF particles crept into the diagonal
-   gaps of its staircase, 1.41 dx, and the push along the end's normal sent them out within
-   0.06-0.14 s; tests/test_scenes.c, drum_2d). Measured on the alternatives: the start's normal
-   only where the end's turned against it (over 90 degrees) still let DFSPH and PBF out of that
-   drum; the start's normal always put a particle through the 3D shell's corner
-   (scenes/shell_3d) and doubled the front's distance between PCISPH's and WCSPH's dam breaks
-   (pcisph/dam_break_vs_wcsph, 0.31 against 0.15). A second pass, for a particle pushed onto
-   another wall, follows the normal where it is. */
-static int sph__wall_contact(const sph__ctx* c, size_t i, sph_real dc, sph_real lead,
-                             const sph_real* xs, sph_real lead_s, sph_real* xi, sph_real* vi) {
+/* One particle's contact: its distance d [m] to the nearest wall particle (d_c, or less on the
+   3D ramp), d_c [m] to every other, the walls' lead at the step's end and at the drift's start
+   (sph__wall_delta). */
+typedef struct sph__contact_arg {
+    sph_real d, d_c, lead, lead_s;
+    const uint8_t* thin; /* sph__wall_thin's flags, or NULL (every wall thick) */
+} sph__contact_arg;
+
+/* The contact of particle i, from the drift's start x_s. Measured on drums of one layer of
+   lattice points (R <= r < R + dx, Akinci volumes, turning at 2 rad/s about their axis, a third
+   full; tests/test_scenes.c, drum_2d):
+   - The ramp's lower distance d holds only for the nearest wall particle, d_c for the others:
+     with d for every one, the hollows of a wall lattice (0.71 dx from their corners) and the gaps
+     of a sampled surface (0.87 dx in the 3D drum) were open at d = 0.6 dx, and 3D drums (dx
+     0.04) let IISPH, DFSPH and PBF particles out within 0.2-0.5 s. Now nothing passes between
+     wall particles closer than 2 d_c (1.25 d_c over a square hollow), as without the ramp; a
+     centre over a hollow stays 0.53 dx above the layer, just over its face, and one over a wall
+     particle 0.6 dx. Another wall particle ahead of the push (dn < 0) is left out: at a junction
+     of walls whose normals differ (a ramp's last row 0.5 dx in front of a box's wall) its d_c
+     pushed a particle 1.5 dx into the wall.
+   - The push follows the wall's normal at the end unless that turned more than 18 degrees
+     (cos 0.95) from the normal at x_s, where the step found the particle on the fluid side: in
+     the line of a single layer, and in the gaps between its particles, the end's normal has no
+     side. Along the end's normal IISPH, DFSPH and PBF particles crept into the diagonal gaps of
+     the 2D drum's staircase (1.41 dx) and were sent out within 0.06-0.14 s (dx 0.01-0.02); with
+     the start's normal beyond 90 degrees DFSPH and PBF still got out at dx 0.02, beyond 60
+     degrees DFSPH at dx 0.01; the start's normal always put a particle through the 3D shell's
+     corner (scenes/shell_3d) and doubled the front's distance between PCISPH's and WCSPH's dam
+     breaks (pcisph/dam_break_vs_wcsph, 0.31 against 0.15).
+   - A second pass, for a particle pushed onto another wall, follows the normal where it is.
+   With both, the drums run 2 s with every solver and nothing out (2D at dx 0.01, 0.015, 0.02;
+   3D at dx 0.04), but IISPH's 2D drum at dx 0.015 fails at 1.86 s (reported). Drums of one
+   layer with given volumes (dx^dim: not the recipe for one layer, see SPH_BVOL_AKINCI) still
+   let IISPH, DFSPH and PBF particles out in 3D within 0.4-0.5 s. */
+static int sph__wall_contact(const sph__ctx* c, size_t i, const sph__contact_arg* a,
+                             const sph_real* xs, sph_real* xi, sph_real* vi) {
     const int D = c->dim;
     const size_t k0 = c->fb->begin[i], k1 = k0 + c->fb->count[i];
-    const sph_real dc2 = dc * dc;
+    const sph_real dc2 = a->d_c * a->d_c, d2 = a->d < a->d_c ? a->d * a->d : dc2;
+    sph_real do2; /* the others' distance^2: d_c at a thin wall, else d */
+    const sph_real lead = a->lead;
     int pass, moved = 0;
     for (pass = 0; pass < 2; ++pass) { /* a second pass for a particle pushed onto another wall */
-        sph_real g[3], n[3] = {0, 0, 0}, gn = 0, s = 0, vn = 0, r2min = dc2;
+        sph_real g[3], n[3] = {0, 0, 0}, gn = 0, s = 0, vn = 0, r2min = dc2, r2second = dc2;
         sph_real dn_near[3] = {0, 0, 0};
         size_t kk, near = k1;
         int k;
-        for (kk = k0; kk < k1; ++kk) { /* the nearest wall particle within d_c, if any */
+        for (kk = k0; kk < k1; ++kk) { /* the nearest two wall particles within d_c, if any */
             sph_real d[3] = {0, 0, 0}, r2 = 0;
             sph__wall_delta(c, xi, c->fb->idx[kk], lead, d);
             for (k = 0; k < D; ++k) r2 += d[k] * d[k];
             if (r2 < r2min) {
+                r2second = r2min;
                 r2min = r2;
                 near = kk;
                 for (k = 0; k < D; ++k) dn_near[k] = d[k];
+            } else if (r2 < r2second) {
+                r2second = r2;
             }
         }
-        if (near == k1) break; /* nothing within d_c: no kernel gradient needed */
+        if (near == k1) break;
+        do2 = a->thin && a->thin[c->fb->idx[near]] ? dc2 : d2;
+        /* nearest at least d, the others at least their distance: nothing to do */
+        if (!(r2min < d2) && !(r2second < do2)) break;
         sph__wall_normal(c, i, xi, lead, g);
         for (k = 0; k < D; ++k) gn += g[k] * g[k];
-        if (pass == 0) { /* the start's normal where the end's turned from it by over 60 deg */
+        if (pass == 0) { /* the start's normal where the end's turned from it by over 18 deg */
             sph_real gs[3], dot = 0, gs2 = 0;
-            sph__wall_normal(c, i, xs, lead_s, gs);
+            sph__wall_normal(c, i, xs, a->lead_s, gs);
             for (k = 0; k < D; ++k) { dot += g[k] * gs[k]; gs2 += gs[k] * gs[k]; }
-            if (gs2 > 0 && !(dot > SPH__R(0.5) * sph__sqrt(gn * gs2))) {
+            if (gs2 > 0 && !(dot > SPH__R(0.95) * sph__sqrt(gn * gs2))) {
                 for (k = 0; k < D; ++k) g[k] = gs[k];
                 gn = gs2;
             }
@@ -6356,11 +6450,16 @@ static int sph__wall_contact(const sph__ctx* c, size_t i, sph_real dc, sph_real 
         }
         for (kk = k0; kk < k1; ++kk) {
             const size_t b = c->fb->idx[kk];
+            const sph_real rb2 = kk == near ? d2 : do2;
             sph_real d[3] = {0, 0, 0}, r2 = 0, dn = 0, sb;
             sph__wall_delta(c, xi, b, lead, d);
             for (k = 0; k < D; ++k) { r2 += d[k] * d[k]; dn += d[k] * n[k]; }
-            if (!(r2 < dc2)) continue;
-            sb = -dn + sph__sqrt(dn * dn - r2 + dc2); /* real: dc2 > r2 */
+            /* on the ramp, another wall particle ahead along n (dn < 0) is not cleared by a push
+               along n but through it and beyond: at a junction of walls whose normals differ (a
+               ramp's row 0.5 dx in front of a box's wall) d_c for it pushed a particle 1.5 dx
+               into the wall */
+            if (!(r2 < rb2) || (rb2 > d2 && dn < 0)) continue;
+            sb = -dn + sph__sqrt(dn * dn - r2 + rb2); /* real: rb2 > r2 */
             if (sb > s) s = sb;
         }
         for (k = 0; k < D; ++k) {
@@ -6624,18 +6723,22 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
             if (!final) continue;
             if (sh) for (kk = 0; kk < D; ++kk) sh[i * (size_t)D + (size_t)kk] = xi[kk];
             if (dc > 0 && c->fb->count[i] > 0) {
-                sph_real d = dc;
+                sph__contact_arg ca;
+                ca.d = ca.d_c = dc;
+                ca.lead = lead;
+                ca.lead_s = lead - kx;
+                ca.thin = ramp && w->priv.b_thin_on ? w->priv.b_thin : NULL;
                 if (ramp) { /* from d_c short of neighbours down to 0.6 dx with a full set */
                     const sph_real d0 = SPH__R(SPH__CONTACT_REST) * w->dx;
                     const sph_real nf = (sph_real)(c->ff->count[i] + c->fb->count[i]) * inv_full;
                     sph_real f = (w->priv.contact_full - nf) /
                                  (w->priv.contact_full - w->priv.contact_short);
                     f = f < 0 ? 0 : f > 1 ? 1 : f;
-                    d = d0 + f * (dc > d0 ? dc - d0 : 0);
+                    ca.d = d0 + f * (dc > d0 ? dc - d0 : 0);
                 }
                 if (guard && sph__wall_cross_guard(c, i, xold, gold, lead, xi, vi))
                     r[SPH__RED_CONTACT] += 1;
-                else if (sph__wall_contact(c, i, d, lead, xold, lead - kx, xi, vi))
+                else if (sph__wall_contact(c, i, &ca, xold, xi, vi))
                     r[SPH__RED_CONTACT] += 1;
             }
             if (sh) /* the contact's (and the guard's) displacement */
