@@ -351,8 +351,9 @@ int main(void) {
    density (continuity, particle density) gains the compression that move makes, as a summation
    density would (sph__contact_density). In 3D with zero
    wall pressure and PCISPH, IISPH or DFSPH that distance is for particles short of neighbours
-   (fewer fluid and wall neighbours than 0.7 of a full lattice's) and ramps down to 0.6 dx, from
-   the nearest wall particle only, for those with 0.85 and more: zero wall pressure rests those
+   (fewer fluid and wall neighbours than 0.7 of a full lattice's) and ramps down to 0.6 dx (at a
+   wall of one layer from the nearest wall particle only) for those with 0.85 and more: zero wall
+   pressure rests those
    rows 0.5-0.65 dx from the wall's first layer, and a contact that fought them kept a 3D tank at
    rest moving at 0.2 sqrt(g H) (see sph__wall_contact). Moving walls are taken where the step
    ends. Measured on
@@ -6275,10 +6276,11 @@ static sph_real sph__wall_fraction(const sph__ctx* c, const sph_real* xi, size_t
    lattice neighbourhood (0.85 for Wendland C2 at h = 1.3 dx, from the kernel's lattice by
    sph__contact_ramp; the count sph__enclosed uses) has the wall supply only what a fluid
    would, so the pressure solve, which holds its density, holds it, and its contact distance is
-   SPH__CONTACT_REST dx from its nearest wall particle and d_c from the others (over a wall
-   particle its centre stays 0.1 dx on the fluid side of the wall's face; over the hollow between
-   wall particles 0.03 dx, where zero wall pressure's resting rows sit, +-0.04 dx; see
-   sph__wall_contact for why the others keep d_c); the distance grows linearly to d_c as the count
+   SPH__CONTACT_REST dx (over a wall particle its centre stays 0.1 dx on the fluid side of the
+   wall's face; over the hollow between wall particles it is free to reach the face, where zero
+   wall pressure's resting rows sit, +-0.04 dx; at a wall of one layer only the nearest wall
+   particle has the shorter distance, see sph__wall_contact); the distance grows linearly to d_c
+   as the count
    falls to a fraction "short" (0.7) of a full set (a switch instead
    of the ramp moved a particle 0.4 dx in one step whenever its count crossed the line, and its
    neighbours answered at 0.1-0.14 sqrt(g H)). Why: zero wall pressure's resting state is not the
@@ -6376,15 +6378,18 @@ typedef struct sph__contact_arg {
 /* The contact of particle i, from the drift's start x_s. Measured on drums of one layer of
    lattice points (R <= r < R + dx, Akinci volumes, turning at 2 rad/s about their axis, a third
    full; tests/test_scenes.c, drum_2d):
-   - The ramp's lower distance d holds only for the nearest wall particle, d_c for the others:
-     with d for every one, the hollows of a wall lattice (0.71 dx from their corners) and the gaps
-     of a sampled surface (0.87 dx in the 3D drum) were open at d = 0.6 dx, and 3D drums (dx
-     0.04) let IISPH, DFSPH and PBF particles out within 0.2-0.5 s. Now nothing passes between
-     wall particles closer than 2 d_c (1.25 d_c over a square hollow), as without the ramp; a
-     centre over a hollow stays 0.53 dx above the layer, just over its face, and one over a wall
-     particle 0.6 dx. Another wall particle ahead of the push (dn < 0) is left out: at a junction
-     of walls whose normals differ (a ramp's last row 0.5 dx in front of a box's wall) its d_c
-     pushed a particle 1.5 dx into the wall.
+   - At a thin wall (sph__wall_thin: one layer) the ramp's lower distance d holds only for the
+     nearest wall particle, d_c for the others: with d for every one, the hollows of the layer
+     (0.71 dx from their corners) and its gaps (0.87 dx in the 3D drum) were open at d = 0.6 dx,
+     and 3D drums (dx 0.04) let IISPH, DFSPH and PBF particles out within 0.2-0.5 s. There
+     nothing passes between wall particles closer than 2 d_c (1.25 d_c over a square hollow), as
+     without the ramp; a centre over a hollow stays 0.53 dx above the layer, just over its face,
+     and one over a wall particle 0.6 dx. Another wall particle ahead of the push (dn < 0) is
+     left out: at a junction of walls whose normals differ (a ramp's last row 0.5 dx in front of
+     a box's wall) its d_c pushed a particle 1.5 dx into the wall. Thick walls keep d for every
+     wall particle: d_c for the others there (pushing rows over the hollows up to 0.53 dx) kept a
+     3D tank at rest moving at 0.044 (IISPH) and 0.091 (DFSPH) sqrt(g H) after 10 s instead of
+     0.0084 and 0.028 (long/scenes/tank_3d_settles).
    - The push follows the wall's normal at the end unless that turned more than 18 degrees
      (cos 0.95) from the normal at x_s, where the step found the particle on the fluid side: in
      the line of a single layer, and in the gaps between its particles, the end's normal has no
