@@ -5059,16 +5059,23 @@ static sph_status sph__stage_boundary_volume(sph_world* w, sph_real radius, int 
 
 /* Which wall particles form a thin wall (one layer, as a host samples a surface): those whose
    kernel sum over their wall neighbours (themselves included) lies below midway between a
-   lattice plane's and a half space's (priv.thin_sum). The 3D wall contact keeps the ramp's
-   shorter distance (zero wall pressure's resting rows) for a thick wall only; at a thin one
-   every wall particle but the nearest keeps d_c, which closes the layer's hollows and gaps
-   (sph__wall_contact). Static walls: once; moved walls: at every sort, with the lists the
+   lattice plane's and a half space's (priv.thin_sum), and every one with Akinci volumes. The 3D
+   wall contact keeps the ramp's shorter distance (zero wall pressure's resting rows) for a thick
+   wall of given volumes only: the ramp rests on the wall supplying the density a fluid would,
+   which a lattice wall of given volumes does; at a thin one every wall particle but the nearest
+   keeps d_c, which closes the layer's hollows and gaps (sph__wall_contact). Akinci volumes,
+   gamma_1 / sum W calibrated for one layer, give the first layer of a thick lattice wall 0.74
+   (Wendland C2) or 0.82 (cubic) of dx^3, and its corners 0.59 or 0.70 (a 3D box of
+   sph_add_wall_box, dx 0.02): with the ramp there the original PCISPH sank a
+   particle through the first layer at the corner of a 3D box of sph_add_wall_box (dx 0.04, at
+   0.16 s, reported by the tank check); as thin walls it holds. Static walls: once; moved walls: at every sort, with the lists the
    Akinci volumes use (searched here when those are not). Only where the ramp applies (3D, the
    incompressible solvers). */
 static int sph__incompressible(int solver);
 static sph_status sph__wall_thin(sph_world* w, sph_real radius, int search) {
     const int D = w->dim;
     const double w0 = (double)sph__kw(w->kernel.form, 0);
+    const int akinci = w->def.boundary_volume == SPH_BVOL_AKINCI;
     sph__idx b;
     if (search) {
         sph_status s = sph__neighbors_build(&w->priv.bb, &w->priv.bgrid, w->b_x, NULL, w->b_x,
@@ -5089,7 +5096,7 @@ static sph_status sph__wall_thin(sph_world* w, sph_real radius, int search) {
             for (k = 0; k < D; ++k) r2 += d[k] * d[k];
             sum += (double)sph__kw(w->kernel.form, sph__sqrt(r2) * w->kernel.inv_h);
         }
-        w->priv.b_thin[b] = (uint8_t)(sum < w->priv.thin_sum);
+        w->priv.b_thin[b] = (uint8_t)(sum < w->priv.thin_sum || akinci);
     }
     w->priv.b_thin_on = 1;
     return SPH_OK;
