@@ -5220,7 +5220,7 @@ static sph_status sph__sort_by_cell(sph_world* w, sph_real cell) {
             s = sph__stage_boundary_volume(w, cell, 1);
             if (s != SPH_OK) return s;
         }
-        if (w->dim == 3 && sph__incompressible(w->def.solver)) {
+        if (w->dim == 3 && sph__incompressible((int)w->def.solver)) {
             s = sph__wall_thin(w, cell, w->def.boundary_volume != SPH_BVOL_AKINCI);
             if (s != SPH_OK) return s;
         }
