@@ -352,11 +352,10 @@ int main(void) {
    density would (sph__contact_density). In 3D with zero
    wall pressure and PCISPH, IISPH or DFSPH that distance is for particles short of neighbours
    (fewer fluid and wall neighbours than 0.7 of a full lattice's) and ramps down to 0.6 dx (at a
-   wall of one layer from the nearest wall particle only) for those with 0.85 and more: zero wall
-   pressure rests those
-   rows 0.5-0.65 dx from the wall's first layer, and a contact that fought them kept a 3D tank at
-   rest moving at 0.2 sqrt(g H) (see sph__wall_contact). Moving walls are taken where the step
-   ends. Measured on
+   wall of one layer, or of Akinci volumes, from the nearest wall particle only) for those with
+   0.85 and more: zero wall pressure rests those rows 0.5-0.65 dx from the wall's first layer, and
+   a contact that fought them kept a 3D tank at rest moving at 0.2 sqrt(g H) (see
+   sph__wall_contact). Moving walls are taken where the step ends. Measured on
    the 3D dam break at dx 0.05 (./build/bench tts --scene 3d-6k): fluid particles outside the
    container at a frame end, most at once, 390 -> 0 (WCSPH), 904 -> 0 (IISPH), 915 -> 0 (DFSPH);
    a one-particle sheet dropped on a host-placed floor (tests/test_reliability.c) sinks 0.67 dx
@@ -5066,11 +5065,11 @@ static sph_status sph__stage_boundary_volume(sph_world* w, sph_real radius, int 
    keeps d_c, which closes the layer's hollows and gaps (sph__wall_contact). Akinci volumes,
    gamma_1 / sum W calibrated for one layer, give the first layer of a thick lattice wall 0.74
    (Wendland C2) or 0.82 (cubic) of dx^3, and its corners 0.59 or 0.70 (a 3D box of
-   sph_add_wall_box, dx 0.02): with the ramp there the original PCISPH sank a
-   particle through the first layer at the corner of a 3D box of sph_add_wall_box (dx 0.04, at
-   0.16 s, reported by the tank check); as thin walls it holds. Static walls: once; moved walls: at every sort, with the lists the
-   Akinci volumes use (searched here when those are not). Only where the ramp applies (3D, the
-   incompressible solvers). */
+   sph_add_wall_box, dx 0.02): with the ramp there the original PCISPH sank a particle through
+   the first layer at the corner of a 3D box of sph_add_wall_box (dx 0.04, at 0.16 s, reported
+   by the tank check); as thin walls it holds. Static walls: once; moved walls: at every sort,
+   with the lists the Akinci volumes use (searched here when those are not). Only where the ramp
+   may apply (3D, the incompressible solvers). */
 static int sph__incompressible(int solver);
 static sph_status sph__wall_thin(sph_world* w, sph_real radius, int search) {
     const int D = w->dim;
