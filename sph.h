@@ -5021,39 +5021,45 @@ static size_t sph__count_within(const sph_grid* g, const sph_real* p, const sph_
 }
 #endif
 
+/* The walls' own neighbour lists within radius (the kernel's support, or def.neighbor_skin's
+   candidate radius, whose lists serve the steps that reuse them: the kernel is exactly 0 from its
+   support on), for the two per-wall-particle sums below. */
+static sph_status sph__wall_lists(sph_world* w, sph_real radius) {
+    sph_status s = sph__neighbors_build(&w->priv.bb, &w->priv.bgrid, w->b_x, NULL, w->b_x, w->nb,
+                                        radius, 1);
+    if (s != SPH_OK)
+        return sph__fail(w, s, -1, "boundary neighbour lists: %s", sph_status_string(s));
+    return SPH_OK;
+}
+
+/* sum_b' W_bb' / norm_w over wall particle b's wall neighbours, b itself included. */
+static sph_real sph__wall_kernel_sum(const sph_world* w, size_t b) {
+    const int D = w->dim;
+    const sph_neighbors* nl = &w->priv.bb;
+    size_t kk, k0 = nl->begin[b], k1 = k0 + nl->count[b];
+    sph_real sum = sph__kw(w->kernel.form, 0);
+    for (kk = k0; kk < k1; ++kk) {
+        const size_t q = nl->idx[kk];
+        sph_real d[3] = {0, 0, 0}, r2 = 0;
+        int k;
+        sph_grid_delta(&w->priv.bgrid, w->b_x + b * (size_t)D, w->b_x + q * (size_t)D, d);
+        for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+        sum += sph__kw(w->kernel.form, sph__sqrt(r2) * w->kernel.inv_h);
+    }
+    return sum;
+}
+
 /* Akinci et al. 2012 (Meiers 2025 eq. 27): a wall particle's volume is gamma_1 over its number
    density among wall particles, V_b = gamma_1 S / sum_b' W_bb' (b itself included; S the
    lattice sum, so a full lattice of wall particles keeps V_b = dx^dim), so sparse or single-layer
    walls weigh as much as a full lattice and dense clusters do not count twice. Recomputed
    whenever the walls are re-sorted (every step when they move). */
-static sph_status sph__stage_boundary_volume(sph_world* w, sph_real radius, int search) {
-    const int D = w->dim;
-    const sph_real w0 = sph__kw(w->kernel.form, 0);
+static void sph__stage_boundary_volume(sph_world* w) {
     sph__idx b;
-    /* radius: the kernel's support, or def.neighbor_skin's candidate radius, whose lists serve
-       the steps that reuse them (the kernel is exactly 0 from its support on) */
-    if (search) {
-        sph_status s = sph__neighbors_build(&w->priv.bb, &w->priv.bgrid, w->b_x, NULL, w->b_x,
-                                            w->nb, radius, 1);
-        if (s != SPH_OK)
-            return sph__fail(w, s, -1, "boundary neighbour lists: %s", sph_status_string(s));
-    }
     SPH__OMP_FOR(w->nb)
-    for (b = 0; b < (sph__idx)w->nb; ++b) {
-        const sph_neighbors* nl = &w->priv.bb;
-        size_t kk, k0 = nl->begin[b], k1 = k0 + nl->count[b];
-        sph_real sum = w0;
-        for (kk = k0; kk < k1; ++kk) {
-            const size_t q = nl->idx[kk];
-            sph_real d[3] = {0, 0, 0}, r2 = 0;
-            int k;
-            sph_grid_delta(&w->priv.bgrid, w->b_x + (size_t)b * (size_t)D, w->b_x + q * (size_t)D, d);
-            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
-            sum += sph__kw(w->kernel.form, sph__sqrt(r2) * w->kernel.inv_h);
-        }
-        w->b_vol[b] = w->def.boundary_gamma * w->priv.lattice_sum / (w->kernel.norm_w * sum);
-    }
-    return SPH_OK;
+    for (b = 0; b < (sph__idx)w->nb; ++b)
+        w->b_vol[b] = w->def.boundary_gamma * w->priv.lattice_sum /
+                      (w->kernel.norm_w * sph__wall_kernel_sum(w, (size_t)b));
 }
 
 /* Which wall particles form a thin wall (one layer, as a host samples a surface): those whose
@@ -5067,38 +5073,17 @@ static sph_status sph__stage_boundary_volume(sph_world* w, sph_real radius, int 
    (Wendland C2) or 0.82 (cubic) of dx^3, and its corners 0.59 or 0.70 (a 3D box of
    sph_add_wall_box, dx 0.02): with the ramp there the original PCISPH sank a particle through
    the first layer at the corner of a 3D box of sph_add_wall_box (dx 0.04, at 0.16 s, reported
-   by the tank check); as thin walls it holds. Static walls: once; moved walls: at every sort,
-   with the lists the Akinci volumes use (searched here when those are not). Only where the ramp
-   may apply (3D, the incompressible solvers). */
-static int sph__incompressible(int solver);
-static sph_status sph__wall_thin(sph_world* w, sph_real radius, int search) {
-    const int D = w->dim;
-    const double w0 = (double)sph__kw(w->kernel.form, 0);
+   by the tank check); as thin walls it holds. Static walls: once; moved walls: at every sort
+   (a rigid motion keeps the flags). Only where the ramp may apply (3D, the incompressible
+   solvers). */
+static void sph__wall_thin(sph_world* w) {
     const int akinci = w->def.boundary_volume == SPH_BVOL_AKINCI;
     sph__idx b;
-    if (search) {
-        sph_status s = sph__neighbors_build(&w->priv.bb, &w->priv.bgrid, w->b_x, NULL, w->b_x,
-                                            w->nb, radius, 1);
-        if (s != SPH_OK)
-            return sph__fail(w, s, -1, "boundary neighbour lists: %s", sph_status_string(s));
-    }
     SPH__OMP_FOR(w->nb)
-    for (b = 0; b < (sph__idx)w->nb; ++b) {
-        const sph_neighbors* nl = &w->priv.bb;
-        size_t kk, k0 = nl->begin[b], k1 = k0 + nl->count[b];
-        double sum = w0;
-        for (kk = k0; kk < k1; ++kk) {
-            sph_real d[3] = {0, 0, 0}, r2 = 0;
-            int k;
-            sph_grid_delta(&w->priv.bgrid, w->b_x + (size_t)b * (size_t)D,
-                           w->b_x + nl->idx[kk] * (size_t)D, d);
-            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
-            sum += (double)sph__kw(w->kernel.form, sph__sqrt(r2) * w->kernel.inv_h);
-        }
-        w->priv.b_thin[b] = (uint8_t)(sum < w->priv.thin_sum || akinci);
-    }
+    for (b = 0; b < (sph__idx)w->nb; ++b)
+        w->priv.b_thin[b] =
+            (uint8_t)(akinci || (double)sph__wall_kernel_sum(w, (size_t)b) < w->priv.thin_sum);
     w->priv.b_thin_on = 1;
-    return SPH_OK;
 }
 
 /* A grid's cells made `cell` wide, its arrays kept (the periodic box from w.def, as at
@@ -5188,10 +5173,14 @@ static sph_real sph__max_shift2(const sph_grid* g, const sph_real* x, const sph_
     return m;
 }
 
+static int sph__incompressible(int solver);
+
 /* The particles sorted by cell, in cells of `cell` (the grids re-celled if theirs differ): the
    fluid always, the walls when they moved or were added (or re-celled), with their Akinci
    volumes recomputed then. Shared by the search with and without a skin. */
 static sph_status sph__sort_by_cell(sph_world* w, sph_real cell) {
+    const int akinci = w->def.boundary_volume == SPH_BVOL_AKINCI;
+    const int thin = w->dim == 3 && sph__incompressible((int)w->def.solver); /* sph__wall_thin */
     sph__array arr[16];
     sph_status s;
     int narr;
@@ -5215,14 +5204,12 @@ static sph_status sph__sort_by_cell(sph_world* w, sph_real cell) {
         narr = sph__boundary_arrays(w, arr);
         sph__permute(w, arr, narr, w->priv.bgrid.order, w->nb);
         w->priv.b_thin_on = 0;
-        if (w->def.boundary_volume == SPH_BVOL_AKINCI) {
-            s = sph__stage_boundary_volume(w, cell, 1);
+        if (akinci || thin) {
+            s = sph__wall_lists(w, cell);
             if (s != SPH_OK) return s;
         }
-        if (w->dim == 3 && sph__incompressible((int)w->def.solver)) {
-            s = sph__wall_thin(w, cell, w->def.boundary_volume != SPH_BVOL_AKINCI);
-            if (s != SPH_OK) return s;
-        }
+        if (akinci) sph__stage_boundary_volume(w);
+        if (thin) sph__wall_thin(w);
         /* only now: out of memory for the Akinci volumes must leave the walls dirty, or static
            walls would keep their given volumes for good */
         w->priv.b_dirty = 0;
@@ -5373,8 +5360,7 @@ static sph_status sph__stage_neighbors_skin(sph_world* w, sph_real rs) {
         if (s != SPH_OK) return s;
     } else if (w->nb > 0 && w->def.boundary_motion && w->def.boundary_volume == SPH_BVOL_AKINCI) {
         /* moved walls, not sorted again: their volumes from the kept wall lists */
-        s = sph__stage_boundary_volume(w, rs, 0);
-        if (s != SPH_OK) return s;
+        sph__stage_boundary_volume(w);
     }
     s = sph__neighbors_filter(&w->priv.ff, &w->priv.cff, &w->priv.grid, w->x, w->x, R);
     if (s == SPH_OK && w->nb > 0) {
