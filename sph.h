@@ -6365,6 +6365,7 @@ static int sph__wall_cross_guard(const sph__ctx* c, size_t i, const sph_real* xo
 typedef struct sph__contact_arg {
     sph_real d, d_c, lead, lead_s;
     const uint8_t* thin; /* sph__wall_thin's flags, or NULL (every wall thick) */
+    const sph_real* gs;  /* the wall normal at x_s if the crossing guard took it, else NULL */
 } sph__contact_arg;
 
 /* The contact of particle i, from the drift's start x_s. Measured on drums of one layer of
@@ -6430,7 +6431,8 @@ static int sph__wall_contact(const sph__ctx* c, size_t i, const sph__contact_arg
         for (k = 0; k < D; ++k) gn += g[k] * g[k];
         if (pass == 0) { /* the start's normal where the end's turned from it by over 18 deg */
             sph_real gs[3], dot = 0, gs2 = 0;
-            sph__wall_normal(c, i, xs, a->lead_s, gs);
+            if (a->gs) for (k = 0; k < D; ++k) gs[k] = a->gs[k];
+            else sph__wall_normal(c, i, xs, a->lead_s, gs);
             for (k = 0; k < D; ++k) { dot += g[k] * gs[k]; gs2 += gs[k] * gs[k]; }
             if (gs2 > 0 && !(dot > SPH__R(0.95) * sph__sqrt(gn * gs2))) {
                 for (k = 0; k < D; ++k) g[k] = gs[k];
@@ -6725,6 +6727,7 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 ca.lead = lead;
                 ca.lead_s = lead - kx;
                 ca.thin = ramp && w->priv.b_thin_on ? w->priv.b_thin : NULL;
+                ca.gs = guard ? gold : NULL;
                 if (ramp) { /* from d_c short of neighbours down to 0.6 dx with a full set */
                     const sph_real d0 = SPH__R(SPH__CONTACT_REST) * w->dx;
                     const sph_real nf = (sph_real)(c->ff->count[i] + c->fb->count[i]) * inv_full;
