@@ -3860,6 +3860,14 @@ static sph_real sph__pinf(const sph_phase* P) {
     return P->rest_density * P->sound_speed * P->sound_speed / P->gamma - P->back_pressure;
 }
 
+/* The specific internal energy [J/kg] of a gas at pressure p and density rho, from
+   p = (gamma - 1) rho e - gamma p_inf: e = (p + gamma p_inf) / (gamma - 1) / rho. Divided in this
+   order, in double, so that a gas at zero pressure (dust) has e = 0 even at a density whose
+   product with (gamma - 1) underflows to 0 (which would give 0/0). */
+static sph_real sph__gas_energy(sph_real p, sph_real gamma, sph_real pinf, sph_real rho) {
+    return (sph_real)(((double)p + (double)gamma * (double)pinf) / ((double)gamma - 1) / (double)rho);
+}
+
 /* The rules for a phase, shared by sph_world_add_phase and the loader. Fills in the defaults
    (gamma, the ideal gas's sound speed, the mass) of a phase as given; a saved phase (`saved`) has
    them filled in already, so its gamma and mass must be set and an ideal gas's sound speed must
@@ -3926,6 +3934,11 @@ static sph_status sph__check_phase_fields(sph_world* w, sph_phase* ph, int saved
                     (double)(ph->rest_density * ph->sound_speed * ph->sound_speed / ph->gamma),
                     (double)ph->back_pressure);
     }
+    SPH__PCHECK(!gas || sph__finite((double)sph__gas_energy(ph->back_pressure, ph->gamma,
+                                                             sph__pinf(ph), ph->rest_density)),
+                "sph_phase: a gas's internal energy at rest (back_pressure + gamma p_inf) / "
+                "((gamma - 1) rest_density) is not finite (in sph_real) with gamma %g and "
+                "rest_density %g", (double)ph->gamma, (double)ph->rest_density);
     vol = (double)w->dx;
     if (w->dim >= 2) vol *= (double)w->dx;
     if (w->dim >= 3) vol *= (double)w->dx;
@@ -4031,8 +4044,7 @@ static sph_status sph__append_fluid(sph_world* w, int phase, size_t n, const sph
         w->p[j] = gas || !rho_in ? P->back_pressure : sph__eos_phase(P, w->rho[j]);
         w->drho[j] = 0;
         if (w->e)
-            w->e[j] = gas ? (P->back_pressure + P->gamma * sph__pinf(P)) / ((P->gamma - 1) * w->rho[j])
-                          : 0;
+            w->e[j] = gas ? sph__gas_energy(P->back_pressure, P->gamma, sph__pinf(P), w->rho[j]) : 0;
         w->id[j] = w->next_id++;
         w->phase[j] = (uint8_t)phase;
         if (w->m) w->m[j] = m_in ? m_in[i] : mass;
@@ -4930,7 +4942,7 @@ SPHDEF sph_status sph_set_hydrostatic(sph_world* w) {
             if (w->def.solver == SPH_SOLVER_WCSPH || w->def.solver == SPH_SOLVER_COMPRESSIBLE) {
                 w->rho[j] = P->rho0 * sph__eos_inverse(P, (sph_real)p);
                 if (P->gas)
-                    w->e[j] = (w->p[j] + P->gamma * P->pinf) / ((P->gamma - 1) * w->rho[j]);
+                    w->e[j] = sph__gas_energy(w->p[j], P->gamma, P->pinf, w->rho[j]);
             } else {
                 w->rho[j] = P->rho0;
             }
