@@ -11,13 +11,13 @@
      ring1  the same with a single layer of boundary particles and Akinci volumes
             (SPH_BVOL_AKINCI, the library's recipe for single-layer walls);
      shell  the dam break in a box whose walls are one layer of boundary particles the host
-            places on the box's faces (Akinci volumes), in 2D and 3D;
+            places on the box's faces (the default volumes, SPH_BVOL_AUTO), in 2D and 3D;
      jet    the shell's column thrown at 10 m/s against the far wall (a violent impact on
             single-layer walls: corner jets three to four times as fast);
      drum   a drum turning at 2 rad/s about its axis (the boundary-motion callback), a third
             full, its wall one layer of the lattice points a host keeps in the band
             R <= r < R + dx (a staircase with diagonal gaps of 1.41 dx; in 3D a cylinder with
-            single-layer end caps), Akinci volumes.
+            single-layer end caps), the default volumes (SPH_BVOL_AUTO).
    Every run checks, frame by frame, that a failure is reported (a status with a message, the
    world as before the failing call), never silent. With each solver's default wall scheme
    (make test: short 2D and 3D variants; make validate: longer and finer) the run must get
@@ -279,8 +279,7 @@ static sc_result sc_run(sc_scene sc, const sc_solver* so, int bp, int dim,
         def.boundary_motion = sc_drum_motion;
         def.boundary_user = &R;
     }
-    if (sc == SC_RING1 || sc == SC_SHELL || sc == SC_JET || sc == SC_DRUM)
-        def.boundary_volume = SPH_BVOL_AKINCI;
+    if (sc == SC_RING1) def.boundary_volume = SPH_BVOL_AKINCI;
     if (sc == SC_BOX) {
         for (k = 0; k < 3; ++k) def.gravity[k] = 0;
         water.viscosity = (sph_real)0.01;

@@ -591,12 +591,13 @@ static void test_advance_stable_step(void) {
    first row (summation density of IISPH's first step), in 2D and 3D; with gamma = 1 that row was
    15 % compressed. The factor itself: 0.585 / 0.587 for Wendland C2 at h = 1.3 dx. Also with
    the kernel IISPH gets by default (in 3D the cubic B-spline at h = dx, whose layer with
-   gamma = 1 overweighs less: 6 % against 15 %). */
+   gamma = 1 overweighs less: 6 % against 15 %). The default volumes (SPH_BVOL_AUTO, g = 2)
+   give the layer the same: the larger of dx^dim and Akinci's. */
 static void test_akinci_gamma(void) {
     int dim, g, kern;
     for (kern = 0; kern < 2; ++kern) { /* Wendland C2; the automatic kernel (only 3D differs) */
         for (dim = 2 + kern; dim <= 3; ++dim)
-            for (g = 0; g < 2; ++g) {
+            for (g = 0; g < 3; ++g) {
                 sph_world_def d = sph_world_def_default(dim);
                 sph_world w;
                 sph_phase water;
@@ -611,12 +612,12 @@ static void test_akinci_gamma(void) {
                 d.spacing = (sph_real)dx;
                 d.solver = SPH_SOLVER_IISPH;
                 d.gravity[1] = 0;
-                d.boundary_volume = SPH_BVOL_AKINCI;
+                d.boundary_volume = g == 2 ? SPH_BVOL_AUTO : SPH_BVOL_AKINCI;
                 if (kern == 0) d.kernel = SPH_KERNEL_WENDLAND_C2;
-                if (g) d.boundary_gamma = 1;
+                if (g == 1) d.boundary_gamma = 1;
                 for (a = 0; a < 3; ++a) hi[a] = (sph_real)(n * dx);
                 CHECK_EQ_INT(sph_world_init(&w, &d), SPH_OK);
-                if (!g && kern == 0) CHECK_NEAR(w.def.boundary_gamma, dim == 2 ? 0.5846 : 0.5872, 5e-4);
+                if (g != 1 && kern == 0) CHECK_NEAR(w.def.boundary_gamma, dim == 2 ? 0.5846 : 0.5872, 5e-4);
                 CHECK(sph_world_add_phase(&w, &water) == 0);
                 CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
                 /* one layer at y = -0.5 dx under the block, wider than it by the kernel's reach */
@@ -642,13 +643,79 @@ static void test_akinci_gamma(void) {
                 }
                 CHECK(cnt > 0);
                 rho /= (double)(cnt ? cnt : 1);
-                TH_NOTE("%dD, %s, gamma %.4f: first row beside a single Akinci layer at rho/rho0 = %.5f",
-                        dim, sph_kernel_name(w.def.kernel), (double)w.def.boundary_gamma, rho / 1000);
-                if (!g) CHECK_NEAR(rho / 1000, 1, 1e-3);
+                TH_NOTE("%dD, %s, gamma %.4f%s: first row beside a single layer at rho/rho0 = %.5f",
+                        dim, sph_kernel_name(w.def.kernel), (double)w.def.boundary_gamma,
+                        g == 2 ? " (default volumes)" : "", rho / 1000);
+                if (g != 1) CHECK_NEAR(rho / 1000, 1, 1e-3);
                 else /* gamma = 1: the layer weighs too much */
                     CHECK_LT(w.def.kernel == SPH_KERNEL_WENDLAND_C2 ? 1.1 : 1.05, rho / 1000);
                 sph_world_free(&w);
             }
+    }
+}
+
+/* The default wall volumes (SPH_BVOL_AUTO) on a lattice wall of several layers are the given ones,
+   bit for bit, within the kernel's reach of the fluid side: a tank of sph_add_wall_box steps
+   exactly as with SPH_BVOL_GIVEN, in 2D and 3D (only the outer layer's edges and corners, out
+   of the fluid's reach, are sparse enough to get Akinci's larger volumes), and a single layer
+   added beside it gets more than dx^dim. */
+static void test_auto_volume_thick(void) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        sph_world w[2];
+        int v;
+        size_t b;
+        for (v = 0; v < 2; ++v) {
+            sph_world_def d = sph_world_def_default(dim);
+            sph_phase water;
+            const sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)0.4, (sph_real)0.4, (sph_real)0.4};
+            const sph_real fhi[3] = {(sph_real)0.4, (sph_real)0.2, (sph_real)0.4};
+            memset(&water, 0, sizeof water);
+            water.rest_density = 1000;
+            d.spacing = (sph_real)0.04;
+            d.solver = SPH_SOLVER_IISPH;
+            d.boundary_volume = v ? SPH_BVOL_AUTO : SPH_BVOL_GIVEN;
+            CHECK(sph_world_init(&w[v], &d) == SPH_OK && sph_world_add_phase(&w[v], &water) == 0 &&
+                  sph_fill_box(&w[v], 0, lo, fhi) == SPH_OK &&
+                  sph_add_wall_box(&w[v], lo, hi, 0, 0) == SPH_OK);
+            CHECK_EQ_INT(sph_advance(&w[v], (sph_real)0.05), SPH_OK);
+        }
+        CHECK_EQ_INT(w[1].def.boundary_volume, SPH_BVOL_AUTO);
+        CHECK(w[0].nb == w[1].nb && w[0].n == w[1].n && w[0].steps == w[1].steps);
+        for (b = 0; b < w[0].nb; ++b) {
+            double out2 = 0;
+            int k;
+            for (k = 0; k < dim; ++k) {
+                const double x = (double)w[0].b_x[b * (size_t)dim + (size_t)k];
+                const double o = x < 0 ? -x : x > 0.4 ? x - 0.4 : 0;
+                out2 += o * o;
+            }
+            CHECK(w[0].b_x[b * (size_t)dim] == w[1].b_x[b * (size_t)dim]);
+            if (sqrt(out2) < (double)w[0].kernel.radius) CHECK(w[0].b_vol[b] == w[1].b_vol[b]);
+        }
+        CHECK(memcmp(w[0].x, w[1].x, w[0].n * (size_t)dim * sizeof(sph_real)) == 0);
+        CHECK(memcmp(w[0].v, w[1].v, w[0].n * (size_t)dim * sizeof(sph_real)) == 0);
+        { /* one layer of host particles above the box: heavier than dx^dim */
+            const size_t nb0 = w[1].nb;
+            sph_real xl[3 * 20];
+            double vmin = 1e30, cell = pow(0.04, dim);
+            size_t i;
+            for (i = 0; i < 20; ++i) {
+                xl[i * (size_t)dim] = (sph_real)(0.02 + 0.04 * (double)(i % 10));
+                xl[i * (size_t)dim + 1] = (sph_real)1.0;
+                if (dim == 3) xl[i * (size_t)dim + 2] = (sph_real)(0.02 + 0.04 * (double)(i / 10));
+            }
+            CHECK_EQ_INT(sph_add_boundary(&w[1], dim == 3 ? 20 : 10, xl, NULL, 0), SPH_OK);
+            CHECK_EQ_INT(sph_advance(&w[1], (sph_real)0.01), SPH_OK);
+            for (b = 0; b < w[1].nb; ++b)
+                if (w[1].b_x[b * (size_t)dim + 1] > (sph_real)0.9 && (double)w[1].b_vol[b] < vmin)
+                    vmin = (double)w[1].b_vol[b];
+            CHECK_EQ_INT(w[1].nb, nb0 + (dim == 3 ? 20 : 10));
+            TH_NOTE("%dD: smallest default volume of a host's single layer %.3f dx^dim", dim, vmin / cell);
+            CHECK_LT(cell, vmin);
+        }
+        sph_world_free(&w[0]);
+        sph_world_free(&w[1]);
     }
 }
 
@@ -752,6 +819,7 @@ const th_test tests_world[] = {
     {"world/write_csv_vtk", test_write_csv_vtk},
     {"world/advance_by_the_stable_step_is_one_step", test_advance_stable_step},
     {"world/akinci_gamma_gives_rest_density", test_akinci_gamma},
+    {"world/auto_volume_keeps_thick_walls", test_auto_volume_thick},
     {"world/automatic_kernel_and_omega", test_auto_kernel},
     {0, 0},
 };
