@@ -61,7 +61,8 @@ static double fza_box_count(const sph_world* w, const sph_real* lo, const sph_re
         double e;
         if (!isfinite((double)lo[k]) || !isfinite((double)hi[k]) || !(hi[k] > lo[k])) return NAN;
         e = (double)((hi[k] - lo[k]) / w->dx);
-        if (!(e <= 1e7)) return INFINITY;
+        /* the library's rule: round(e) spacings, more than 1e7 refused */
+        if (!(floor(e + 0.5) <= 1e7)) return INFINITY;
         e = floor(e + 0.5);
         inner *= e < 1 ? 1 : e;
         all *= (e < 1 ? 1 : e) + (open & (1u << (2 * k)) ? 0 : pad) +

@@ -442,7 +442,8 @@ static double fz_box_count(const sph_world* w, const sph_real* lo, const sph_rea
         double e;
         if (!isfinite((double)lo[k]) || !isfinite((double)hi[k]) || !(hi[k] > lo[k])) return NAN;
         e = (double)((hi[k] - lo[k]) / w->dx);
-        if (!(e < 1e7)) return INFINITY;
+        /* the library's rule: round(e) spacings, more than 1e7 refused */
+        if (!(floor(e + 0.5) <= 1e7)) return INFINITY;
         total *= floor(e + 0.5) + 1 + 2 * pad;
     }
     return total;
@@ -555,8 +556,11 @@ static void fz_op(fz_ctx* c) {
         int pad;
         fz_box(c, 10, lo, hi);
         pad = layers > 0 ? layers : (int)ceil((double)(w->kernel.radius / w->dx));
-        cnt = fz_box_count(w, lo, hi, pad);
-        if (cnt > c->budget_wall && cnt < 1e10) { FZ_LOG("  wall_box skipped (%g)\n", cnt); return; }
+        /* the library enumerates only the shell (the box with its layers minus the box), so a
+           box of 1e6 x 1e6 spacings gives it 9e6 wall particles, not 1e12: its own refusals are
+           a side over 1e7 spacings (INFINITY here) or more than 2^32 - 2 particles */
+        cnt = fz_box_count(w, lo, hi, pad) - fz_box_count(w, lo, hi, 0);
+        if (cnt > c->budget_wall && cnt < 4.3e9) { FZ_LOG("  wall_box skipped (%g)\n", cnt); return; }
         s = sph_add_wall_box(w, lo, hi, layers, open);
         fz_after("sph_add_wall_box", w, s, &before, 1);
         if (s == SPH_OK) c->budget_wall -= (double)(w->nb - before.nb);
