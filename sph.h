@@ -344,8 +344,9 @@ int main(void) {
    keeps them off (tests/test_scenes.c: single-layer ring and box walls, 2D and 3D). The default,
    SPH_BVOL_AUTO, gives each wall particle the larger of its given volume and Akinci's, once when
    walls are added: lattice walls of several layers keep their given volumes, a layer a host
-   samples weighs as a full wall (with dx^dim it weighs too little: a 2D drum of one layer failed
-   within 0.05 s under IISPH, a 3D one let particles out unreported).
+   samples weighs as a full wall (with dx^dim it weighs too little where its particles are
+   sparse: a 2D drum of one layer failed within 0.05 s under IISPH, a 3D one let particles out
+   unreported).
    Wall contact (def.wall_contact, on by default): no pressure scheme stops a particle that is
    short of fluid neighbours (a splash, the one-particle sheet a dam break spreads along the floor)
    from sinking until the wall supplies the volume it lacks, i.e. onto and past the wall's first
@@ -5094,9 +5095,11 @@ static void sph__stage_boundary_volume(sph_world* w) {
    the outermost layer of sph_add_wall_box's walls, which lie beyond the fluid's reach); a wall
    sampled as one layer (sum W that of a plane) gets the volume that gives the fluid beside it
    its rest density (1.02 dx^2 on a straight 2D line of Wendland C2 at h = 1.3 dx).
-   Why: with dx^dim a layer weighs about 0.6 of a full wall, so the fluid beside it stays short
-   of density, zero wall pressure pulls it into the layer and the contact pushes it back onto
-   its neighbours. Measured on drums of one layer (R 0.3 m, half full, at rest or turning at
+   Why: with dx^dim a layer weighs too little where its particles are sparse (the diagonal gaps
+   of a staircase a host samples from a circle: Akinci's volume there is 1.40 dx^dim, its mean
+   over a drum's layer 1.10 dx^2 in 2D and 1.05 dx^3 in 3D), so the fluid there stays short of
+   density, zero wall pressure lets it sink into the layer and the contact pushes it back onto
+   its neighbours. Measured on drums of one layer (R 0.3 m, a third full, at rest or turning at
    2 rad/s): in 2D (dx 0.02) IISPH, DFSPH, both PCISPH and WCSPH failed within 0.05-1.95 s
    (compressed by 20 %, reported); in 3D (dx 0.04) IISPH, DFSPH and PBF let a particle out
    within 0.35-0.4 s, unreported. The max is idempotent (volumes computed again after a load or
