@@ -1003,8 +1003,8 @@ typedef void (*sph_force_fn)(const struct sph_world* w, size_t begin, size_t end
    w->b_v for the boundary particles it moves (identify them by w->b_body, w->b_id or the
    reference position w->b_x0) and may set w->b_a (wall acceleration, used by the pressure
    extrapolation). With a callback set, walls are re-sorted every step. A non-finite b_x, b_v or
-   b_a fails the step with SPH_ERR_ARG after the callback (and a Verlet half drift) changed the
-   world. */
+   b_a, or a b_x too far from the origin for dx (sph_world_def.spacing), fails the step with
+   SPH_ERR_ARG after the callback (and a Verlet half drift) changed the world. */
 typedef void (*sph_boundary_fn)(struct sph_world* w, double time, void* user);
 
 typedef struct sph_world_def {

@@ -285,8 +285,11 @@ static void fz_motion_fn(sph_world* w, double time, void* user) {
         sph_real* arr = which == 0 ? w->b_x : which == 1 ? w->b_v : w->b_a;
         arr[b0 * dim] = (sph_real)(m->calls & 1u ? NAN : INFINITY);
     }
+    /* a non-finite value, or a position past the library's far limit (amp * time of a huge
+       amp): the step fails with SPH_ERR_ARG after the callback changed the world */
     if (!fz_all_finite(w->b_x, w->nb * dim) || !fz_all_finite(w->b_v, w->nb * dim) ||
-        !fz_all_finite(w->b_a, w->nb * dim))
+        !fz_all_finite(w->b_a, w->nb * dim) ||
+        sph__first_far(w->b_x, w->nb * dim, sph__far_limit(w->dx)) < w->nb * dim)
         fz_bad_motion = 1;
 }
 
