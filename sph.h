@@ -1313,6 +1313,10 @@ typedef struct sph__private {
     sph_real* lapc;                 /* laminar viscosity (Morris form): each fluid particle's
                                        Laplacian normalisation 1 / m_i (sph__stage_visc_norm)      */
     size_t lapc_cap;
+    sph_real* wg;                   /* IISPH, DFSPH: per fluid particle sum_b psi_ib grad W_ib and
+                                       sum_b psi_ib v_b . grad W_ib over its wall neighbours, fixed
+                                       within a step ((dim + 1) n; sph__wall_grad_sum)            */
+    size_t wg_cap;
     sph_grid sgrid;                 /* second-order scheme: grid and lists at stage and shifted
                                        positions (the particles are not reordered mid-step)      */
     sph_neighbors snl;
@@ -1725,6 +1729,13 @@ SPHDEF sph_status sph_world_copy(sph_world* dst, const sph_world* src);
 #else
 #define SPH__INLINE static inline
 #endif
+#if defined(__GNUC__) || defined(__clang__)
+#define SPH__NOINLINE static __attribute__((noinline))
+#elif defined(_MSC_VER)
+#define SPH__NOINLINE static __declspec(noinline)
+#else
+#define SPH__NOINLINE static
+#endif
 
 #define SPH__R(x) ((sph_real)(x))
 typedef ptrdiff_t sph__idx; /* signed loop index for OpenMP */
@@ -1749,7 +1760,8 @@ SPH__INLINE sph_real sph__floor(sph_real x) { return floor(x); }
    -fno-math-errno). IEEE add, mul, div and sqrt round a lane exactly as the scalar instruction,
    so the packed and the scalar path give the same bits. SPH_NO_SIMD, or another architecture,
    selects the scalar path (make check builds it). sph__vlt gives a mask (every bit of a lane set
-   where a < b), sph__vand keeps a where the mask is set and gives +0 elsewhere. */
+   where a < b), sph__vand keeps a where the mask is set and gives +0 elsewhere, sph__vandnot
+   keeps a where it is not. */
 #if !defined(SPH_NO_SIMD) && (defined(__SSE2__) || defined(_M_X64) || \
                               (defined(_M_IX86_FP) && _M_IX86_FP >= 2))
 #include <emmintrin.h>
@@ -1766,6 +1778,7 @@ SPH__INLINE sph__v sph__vdiv(sph__v a, sph__v b) { return _mm_div_ps(a, b); }
 SPH__INLINE sph__v sph__vsqrt(sph__v a) { return _mm_sqrt_ps(a); }
 SPH__INLINE sph__v sph__vlt(sph__v a, sph__v b) { return _mm_cmplt_ps(a, b); }
 SPH__INLINE sph__v sph__vand(sph__v m, sph__v a) { return _mm_and_ps(m, a); }
+SPH__INLINE sph__v sph__vandnot(sph__v m, sph__v a) { return _mm_andnot_ps(m, a); }
 #else
 #define SPH__VN 2
 typedef __m128d sph__v;
@@ -1779,6 +1792,7 @@ SPH__INLINE sph__v sph__vdiv(sph__v a, sph__v b) { return _mm_div_pd(a, b); }
 SPH__INLINE sph__v sph__vsqrt(sph__v a) { return _mm_sqrt_pd(a); }
 SPH__INLINE sph__v sph__vlt(sph__v a, sph__v b) { return _mm_cmplt_pd(a, b); }
 SPH__INLINE sph__v sph__vand(sph__v m, sph__v a) { return _mm_and_pd(m, a); }
+SPH__INLINE sph__v sph__vandnot(sph__v m, sph__v a) { return _mm_andnot_pd(m, a); }
 #endif
 #else
 #define SPH__VN 1
@@ -1793,6 +1807,7 @@ SPH__INLINE sph__v sph__vdiv(sph__v a, sph__v b) { return a / b; }
 SPH__INLINE sph__v sph__vsqrt(sph__v a) { return sph__sqrt(a); }
 SPH__INLINE sph__v sph__vlt(sph__v a, sph__v b) { return a < b ? 1 : 0; }
 SPH__INLINE sph__v sph__vand(sph__v m, sph__v a) { return m != 0 ? a : 0; }
+SPH__INLINE sph__v sph__vandnot(sph__v m, sph__v a) { return m != 0 ? 0 : a; }
 #endif
 
 SPH__INLINE int sph__finite(double x) { return x == x && x - x == 0.0; }
@@ -3780,6 +3795,7 @@ SPHDEF void sph_world_free(sph_world* w) {
     SPH_FREE(w->priv.soc);
     SPH_FREE(w->priv.socw);
     SPH_FREE(w->priv.lapc);
+    SPH_FREE(w->priv.wg);
     SPH_FREE(w->priv.snap[0]);
     SPH_FREE(w->priv.snap[1]);
     sph_grid_free(&w->priv.sgrid);
@@ -4441,7 +4457,7 @@ SPHDEF size_t sph_world_memory(const sph_world* w) {
               w->priv.shift_cap +
               w->priv.xp_cap +
               w->priv.vp_cap + w->priv.de_cap + w->priv.cs_cap + w->priv.vn_cap + w->priv.bpq_cap + w->priv.soc_cap + w->priv.socw_cap +
-              w->priv.lapc_cap) *
+              w->priv.lapc_cap + w->priv.wg_cap) *
                  sizeof(sph_real);
     return bytes;
 }
@@ -4568,6 +4584,10 @@ typedef struct sph__ctx {
                                   pressure gradients (see sph__ctx_init), else 1                */
     sph_real* lapc;            /* laminar viscosity, Morris form: 1 / m_i per fluid particle
                                   (sph__stage_visc_norm fills it before each viscous pass)      */
+    const sph_real* wg;        /* the walls' sums of sph__wall_grad_sum, for the cached pressure
+                                  (wg_pressure: zero wall pressure) and rate passes of IISPH's
+                                  and DFSPH's solves, else NULL                                 */
+    int wg_pressure;
     sph_real g[3];
     /* the compressible step */
     const sph_real* e;         /* specific internal energy (NULL without gas phases)             */
@@ -4989,6 +5009,7 @@ static sph_status sph__scratch(sph_world* w, sph_real** p, size_t count) {
                   : p == &w->priv.soc   ? &w->priv.soc_cap
                   : p == &w->priv.socw  ? &w->priv.socw_cap
                   : p == &w->priv.lapc  ? &w->priv.lapc_cap
+                  : p == &w->priv.wg    ? &w->priv.wg_cap
                                         : NULL;
     SPH_ASSERT(cap);
     if (count <= *cap && *p) return SPH_OK;
@@ -5496,18 +5517,82 @@ SPH__INLINE sph_real sph__wall_sum(const sph__ctx* c, size_t i, const sph_real* 
     return sum;
 }
 
+#define SPH__ROW 64 /* neighbours per batch of sph__density_row and sph__accel_row */
+
+/* sph__density_one's fluid sum on the fast path (one mass, no periodic direction; Wendland C2
+   or the cubic spline), in rows of SPH__ROW neighbours as sph__accel_row: the square root and
+   both kernel functions in packed lanes, the cubic's two pieces computed in every lane and the
+   one that applies kept (lanes outside a piece are masked to +0, and x + (+0) is x), then the
+   masses summed in list order. The same expressions in the same order as sph__kw and sph__kf,
+   so the same bits (3D IISPH at 59k particles: the scalar loop's branch on q < 1 went either
+   way at random). Returns sum_j W_ij / norm_w (without m_j) and stores the grad W factors. */
+SPH__INLINE sph_real sph__density_row(const sph__ctx* c, size_t i, const int D, const int form) {
+    const sph_real* xi = c->x + i * (size_t)D;
+    const sph_real far = 4 * c->k.radius * c->k.radius; /* padding lanes: beyond the support */
+    const sph__v v_inv_h = sph__vset(c->k.inv_h), v_norm = sph__vset(c->k.norm_g);
+    const sph__v v_one = sph__vset(1), v_two = sph__vset(2), v_half = sph__vset(SPH__R(0.5));
+    const sph__v v_m5 = sph__vset(-5), v_c15 = sph__vset(SPH__R(1.5));
+    const sph__v v_c075 = sph__vset(SPH__R(0.75)), v_c025 = sph__vset(SPH__R(0.25));
+    const sph__v v_m3 = sph__vset(-3), v_c225 = sph__vset(SPH__R(2.25));
+    const sph__v v_mc075 = sph__vset(SPH__R(-0.75));
+    sph_real r2[SPH__ROW + SPH__VN], wq[SPH__ROW + SPH__VN], fo[SPH__ROW + SPH__VN], sum = 0;
+    size_t b0, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
+    int k;
+    for (b0 = k0; b0 < k1; b0 += SPH__ROW) {
+        const size_t nb = k1 - b0 < SPH__ROW ? k1 - b0 : SPH__ROW;
+        size_t m;
+        for (m = 0; m < nb; ++m) {
+            const sph_real* xj = c->x + c->ff->idx[b0 + m] * (size_t)D;
+            sph_real d[3] = {0, 0, 0}, rr = 0;
+            SPH__FOR_K(D, d[k] = xi[k] - xj[k]);
+            SPH__FOR_K(D, rr += d[k] * d[k]);
+            r2[m] = rr;
+        }
+        for (; m % SPH__VN; ++m) r2[m] = far;
+        for (m = 0; m < nb; m += SPH__VN) {
+            const sph__v q = sph__vmul(sph__vsqrt(sph__vload(r2 + m)), v_inv_h);
+            const sph__v in2 = sph__vlt(q, v_two);
+            sph__v W, F;
+            if (form == SPH__KF_CUBIC) {
+                const sph__v in1 = sph__vlt(q, v_one), t = sph__vsub(v_two, q);
+                /* q < 1: 1 - 1.5 q q + 0.75 q q q and -3 + 2.25 q */
+                const sph__v W1 = sph__vadd(sph__vsub(v_one, sph__vmul(sph__vmul(v_c15, q), q)),
+                                            sph__vmul(sph__vmul(sph__vmul(v_c075, q), q), q));
+                const sph__v F1 = sph__vadd(v_m3, sph__vmul(v_c225, q));
+                /* 1 <= q < 2: 0.25 t t t and -0.75 t t / q, t = 2 - q */
+                const sph__v W2 = sph__vmul(sph__vmul(sph__vmul(v_c025, t), t), t);
+                const sph__v F2 = sph__vdiv(sph__vmul(sph__vmul(v_mc075, t), t), q);
+                W = sph__vadd(sph__vand(in1, W1), sph__vandnot(in1, sph__vand(in2, W2)));
+                F = sph__vadd(sph__vand(in1, F1), sph__vandnot(in1, sph__vand(in2, F2)));
+            } else { /* Wendland C2: t = 1 - q/2; t^2 t^2 (2 q + 1) and -5 t t t */
+                const sph__v t = sph__vsub(v_one, sph__vmul(v_half, q)), t2 = sph__vmul(t, t);
+                const sph__v p1 = sph__vadd(sph__vmul(v_two, q), v_one);
+                W = sph__vand(in2, sph__vmul(sph__vmul(t2, t2), p1));
+                F = sph__vand(in2, sph__vmul(sph__vmul(sph__vmul(v_m5, t), t), t));
+            }
+            sph__vstore(wq + m, W);
+            sph__vstore(fo + m, sph__vmul(v_norm, F));
+        }
+        if (c->ff_fw_out)
+            for (m = 0; m < nb; ++m) c->ff_fw_out[b0 + m] = fo[m];
+        for (m = 0; m < nb; ++m) sum += c->m0 * wq[m];
+    }
+    return sum;
+}
+
 /* rho_i of one particle; D and the kernel form compile-time constants where the stage knows
    them (the loops over k unroll and d[] stays in registers: 3D IISPH's density stage x2). With
    c->ff_fw_out set (IISPH, DFSPH) it also keeps every pair's grad W factor from the same q, for
    the passes of the step that would evaluate the kernel again. */
 SPH__INLINE sph_real sph__density_one(const sph__ctx* c, size_t i, const int D, const int form,
-                                      sph_real w0, sph_real S) {
+                                      sph_real w0, sph_real S, const int fast) {
     const sph_real* xi = c->x + i * (size_t)D;
     const sph_real mi = c->m ? c->m[i] : c->m0;
     sph_real sum = 0, sumb = 0, q;
     size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
     int k;
-    for (kk = k0; kk < k1; ++kk) {
+    if (fast) sum = sph__density_row(c, i, D, form);
+    else for (kk = k0; kk < k1; ++kk) {
         const size_t j = c->ff->idx[kk];
         sph_real d[3] = {0, 0, 0}, r2 = 0;
         sph__delta_vec(c, xi, c->x + j * (size_t)D, d, D);
@@ -5527,16 +5612,20 @@ SPH__INLINE sph_real sph__density_one(const sph__ctx* c, size_t i, const int D, 
    solver would remove by expanding the fluid (Meiers 2025's reference code scales W the same way). */
 static void sph__stage_density_summation(sph_world* w, const sph__ctx* c) {
     const int D = c->dim, form = c->k.form, wc2 = form == SPH__KF_WC2;
+    const int cub = form == SPH__KF_CUBIC; /* 3D IISPH, DFSPH and PBF by default */
+    const int fast = !c->m && !c->periodic_any && (wc2 || cub); /* sph__density_row */
     const sph_real w0 = c->k.norm_w * sph__kw(c->k.form, 0), S = w->priv.lattice_sum;
     sph__idx i;
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) {
         const size_t q = (size_t)i;
-        w->rho[i] = D == 3 ? (wc2 ? sph__density_one(c, q, 3, SPH__KF_WC2, w0, S)
-                                  : sph__density_one(c, q, 3, form, w0, S))
-                  : D == 2 ? (wc2 ? sph__density_one(c, q, 2, SPH__KF_WC2, w0, S)
-                                  : sph__density_one(c, q, 2, form, w0, S))
-                           : sph__density_one(c, q, 1, form, w0, S);
+        w->rho[i] = D == 3 ? (wc2   ? sph__density_one(c, q, 3, SPH__KF_WC2, w0, S, fast)
+                              : cub ? sph__density_one(c, q, 3, SPH__KF_CUBIC, w0, S, fast)
+                                    : sph__density_one(c, q, 3, form, w0, S, 0))
+                  : D == 2 ? (wc2   ? sph__density_one(c, q, 2, SPH__KF_WC2, w0, S, fast)
+                              : cub ? sph__density_one(c, q, 2, SPH__KF_CUBIC, w0, S, fast)
+                                    : sph__density_one(c, q, 2, form, w0, S, 0))
+                           : sph__density_one(c, q, 1, form, w0, S, 0);
     }
 }
 
@@ -5770,7 +5859,6 @@ SPH__INLINE sph_real sph__delta_across(const sph__ctx* c, const sph__phase_c* P,
     return (pi - pj) / (Ki > Kj ? Ki : Kj);
 }
 
-#define SPH__ROW 64 /* neighbours per batch of sph__accel_row */
 
 /* sph__interact_one's fluid pairs on the fast path (viscous passes, with or without pressure,
    STORE or CACHED), in batches of SPH__ROW neighbours: a gather loop reads each neighbour in
@@ -5784,6 +5872,37 @@ SPH__INLINE sph_real sph__delta_across(const sph__ctx* c, const sph__phase_c* P,
    divisions of its term (3D IISPH at 59k particles: the viscous pass, without the
    normalisation, x1.45).
    [adds to ai, m/s^2] */
+/* sph__accel_row's last loop: ai[k] += lm_m dv[k][m] (if lm) + fs_m dd[k][m] over the row, in
+   list order. Not inlined on purpose: inlined into the passes, gcc kept one of the three sums
+   in memory, so every pair waited on a store and a reload (3D IISPH at 59k particles: a fifth
+   of the time of all its neighbour passes); here the sums live in registers. */
+SPH__NOINLINE void sph__row_sum(const int D, size_t nb, const sph_real* lm,
+                                sph_real (*dv)[SPH__ROW], const sph_real* fs,
+                                sph_real (*dd)[SPH__ROW], sph_real* ai) {
+    sph_real a0 = ai[0], a1 = D > 1 ? ai[1] : 0, a2 = D > 2 ? ai[2] : 0;
+    size_t m;
+    if (D == 3 && lm) {
+        for (m = 0; m < nb; ++m) {
+            a0 += lm[m] * dv[0][m]; a1 += lm[m] * dv[1][m]; a2 += lm[m] * dv[2][m];
+            a0 += fs[m] * dd[0][m]; a1 += fs[m] * dd[1][m]; a2 += fs[m] * dd[2][m];
+        }
+    } else if (D == 3) {
+        for (m = 0; m < nb; ++m) {
+            a0 += fs[m] * dd[0][m]; a1 += fs[m] * dd[1][m]; a2 += fs[m] * dd[2][m];
+        }
+    } else if (lm) {
+        for (m = 0; m < nb; ++m) {
+            a0 += lm[m] * dv[0][m]; a1 += lm[m] * dv[1][m];
+            a0 += fs[m] * dd[0][m]; a1 += fs[m] * dd[1][m];
+        }
+    } else {
+        for (m = 0; m < nb; ++m) { a0 += fs[m] * dd[0][m]; a1 += fs[m] * dd[1][m]; }
+    }
+    ai[0] = a0;
+    if (D > 1) ai[1] = a1;
+    if (D > 2) ai[2] = a2;
+}
+
 SPH__INLINE void sph__accel_row(const sph__ctx* c, size_t i, const int D, const int flags,
                                 sph_real* ai) {
     const sph_real* xi = c->x + i * (size_t)D;
@@ -5826,12 +5945,15 @@ SPH__INLINE void sph__accel_row(const sph__ctx* c, size_t i, const int D, const 
             ud[m] = vd;
             rj[m] = c->rho[j];
             if (mor) lj[m] = c->lapc[j];
-            if (flags & SPH__CACHED) fwo[m] = c->ff_fw[b0 + m];
             if (flags & SPH__PRESSURE)
                 pr[m] = (flags & SPH__CACHED) ? c->pr2[j]
                         : c->pr2c             ? c->pr2c[j]
                                               : c->p[j] / (rj[m] * rj[m]);
         }
+        /* cached factors are read in place, but for the last, padded lanes (a copy of the row
+           made here went out as a `rep movs`, whose start-up cost more than the copy) */
+        if (flags & SPH__CACHED)
+            for (m = nb - nb % SPH__VN; m < nb; ++m) fwo[m] = c->ff_fw[b0 + m];
         for (; m % SPH__VN; ++m) {
             r2[m] = far; ud[m] = 0; rj[m] = 1; pr[m] = 0; lj[m] = 0; fwo[m] = 0;
         }
@@ -5839,7 +5961,7 @@ SPH__INLINE void sph__accel_row(const sph__ctx* c, size_t i, const int D, const 
             const sph__v vr2 = sph__vload(r2 + m);
             sph__v fw, sv = v_zero;
             if (flags & SPH__CACHED) {
-                fw = sph__vload(fwo + m);
+                fw = m + SPH__VN <= nb ? sph__vload(c->ff_fw + b0 + m) : sph__vload(fwo + m);
             } else {
                 const sph__v q = sph__vmul(sph__vsqrt(vr2), v_inv_h);
                 const sph__v t = sph__vsub(v_one, sph__vmul(v_half, q));
@@ -5870,11 +5992,9 @@ SPH__INLINE void sph__accel_row(const sph__ctx* c, size_t i, const int D, const 
             sph__vstore(fs + m, sph__vmul(sv, fw));
             if (flags & SPH__STORE) sph__vstore(fwo + m, fw);
         }
-        for (m = 0; m < nb; ++m) {
-            if (flags & SPH__STORE) c->ff_fw_out[b0 + m] = fwo[m];
-            if (mor) SPH__FOR_K(D, ai[k] += lm[m] * dv[k][m]);
-            SPH__FOR_K(D, ai[k] += fs[m] * dd[k][m]);
-        }
+        if (flags & SPH__STORE)
+            for (m = 0; m < nb; ++m) c->ff_fw_out[b0 + m] = fwo[m];
+        sph__row_sum(D, nb, mor ? lm : NULL, dv, fs, dd, ai);
     }
 }
 
@@ -5977,7 +6097,22 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
     }
     /* walls add a pressure, a rate (STORE comes with PRESSURE) or a no-slip viscous term; a
        viscous pass against free-slip walls has none to add */
-    if (c->has_b && ((flags & (SPH__PRESSURE | SPH__RATE)) || (c->noslip && (laminar || c->av)))) {
+    if (c->wg && (flags == (SPH__PRESSURE | SPH__SET | SPH__CACHED)
+                      ? c->wg_pressure
+                      : flags == (SPH__RATE | SPH__CACHED) && !c->delta_on)) {
+        /* the walls' terms from sums taken once a step (sph__wall_grad_sum): zero wall
+           pressure gives sum_b -psi_ib (p_i/rho_i^2) grad W_ib, the density rate
+           sum_b psi_ib (v_i - v_b) . grad W_ib */
+        const sph_real* g = c->wg + i * (size_t)(D + 1);
+        if (flags & SPH__PRESSURE) {
+            SPH__FOR_K(D, ai[k] -= pi_r2 * g[k]);
+        } else {
+            sph_real vg = 0;
+            SPH__FOR_K(D, vg += vi[k] * g[k]);
+            R += vg - g[D];
+        }
+    } else if (c->has_b &&
+               ((flags & (SPH__PRESSURE | SPH__RATE)) || (c->noslip && (laminar || c->av)))) {
         k0 = c->fb->begin[i];
         k1 = k0 + c->fb->count[i];
         for (kk = k0; kk < k1; ++kk) {
@@ -6288,7 +6423,13 @@ static int sph__incompressible(int solver) {
    sum, so a particle deep inside a lattice wall has 1 and one on a flat wall's face 0.5), from
    the step's fluid->wall lists at the particle's position now. */
 static sph_real sph__wall_fraction(const sph__ctx* c, const sph_real* xi, size_t i, sph_real S) {
-    return sph__wall_sum(c, i, xi, c->dim, c->k.form, NULL) * c->k.norm_w / S;
+    const int form = c->k.form, D = c->dim; /* the common kernels as constants: no switch a pair */
+    sph_real sum;
+    if (D == 3 && form == SPH__KF_CUBIC) sum = sph__wall_sum(c, i, xi, 3, SPH__KF_CUBIC, NULL);
+    else if (D == 3 && form == SPH__KF_WC2) sum = sph__wall_sum(c, i, xi, 3, SPH__KF_WC2, NULL);
+    else if (D == 2 && form == SPH__KF_WC2) sum = sph__wall_sum(c, i, xi, 2, SPH__KF_WC2, NULL);
+    else sum = sph__wall_sum(c, i, xi, D, form, NULL);
+    return sum * c->k.norm_w / S;
 }
 
 
@@ -8369,6 +8510,33 @@ SPHDEF sph_status sph_step_pcisph(sph_world* w, sph_real dt) {
    with k_b = d p_b / d p_i: 0 for zero pressure, 1 for mirroring, W_bi / sum_f W_bf for
    extrapolation. a_ii < 0; a particle without neighbours has a_ii = 0 and gets p = 0. */
 
+/* The walls' fixed part of the pressure solves' passes (IISPH, DFSPH), per fluid particle i:
+   out[i (D + 1) + k] = sum_b psi_ib grad_k W_ib and out[i (D + 1) + D] = sum_b psi_ib v_b .
+   grad W_ib, psi_ib = rho0_i V_b, from the grad W factors of the density summation. Within a
+   solve the positions and wall velocities do not change, so a pass with zero wall pressure
+   adds -(p_i/rho_i^2) times the first sum (Akinci et al. 2012's wall term) and the density
+   rate v_i . (first) - (second), where it would run over the wall neighbours in every
+   iteration (3D dam break: a third of the water rests on the floor by t = 1 s). Reading the
+   sums changes the order of the additions, not the terms. */
+SPH__INLINE void sph__wall_grad_sum(const sph__ctx* c, size_t i, const int D, sph_real* out) {
+    const sph_real* xi = c->x + i * (size_t)D;
+    const sph_real rho0 = c->pc[c->ph[i]].rho0;
+    sph_real G[3] = {0, 0, 0}, gv = 0;
+    size_t kk, k0 = c->fb->begin[i], k1 = k0 + c->fb->count[i];
+    int k;
+    for (kk = k0; kk < k1; ++kk) {
+        const size_t b = c->fb->idx[kk];
+        const sph_real* vb = c->bv + b * (size_t)D;
+        const sph_real f = c->fb_fw[kk] * rho0 * c->bvol[b];
+        sph_real d[3] = {0, 0, 0}, vd = 0;
+        sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
+        SPH__FOR_K(D, G[k] += f * d[k]; vd += vb[k] * d[k]);
+        gv += f * vd;
+    }
+    SPH__FOR_K(D, out[i * (size_t)(D + 1) + (size_t)k] = G[k]);
+    out[i * (size_t)(D + 1) + (size_t)D] = gv;
+}
+
 /* Diagonal and source term of fluid particle i (one neighbour pass). */
 SPH__INLINE void sph__iisph_prepare_one(const sph_world* w, const sph__ctx* c, size_t i, const int D,
                                         sph_real dt) {
@@ -8396,21 +8564,21 @@ SPH__INLINE void sph__iisph_prepare_one(const sph_world* w, const sph__ctx* c, s
         for (kk = k0; kk < k1; ++kk) {
             const size_t b = c->fb->idx[kk];
             const sph_real psi = P->rho0 * c->bvol[b];
-            sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, fw, kb = 0, q;
+            sph_real d[3] = {0, 0, 0}, vd = 0, fw = c->fb_fw[kk], kb = 0; /* the summation's */
             sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
-            SPH__FOR_K(D, r2 += d[k] * d[k];
-                       vd += (vi[k] - c->bv[b * (size_t)D + (size_t)k]) * d[k]);
-            q = sph__sqrt(r2) * c->k.inv_h;
-            fw = c->k.norm_g * sph__kf(c->k.form, q);
-            w->priv.fb_fw[kk] = fw;
+            SPH__FOR_K(D, vd += (vi[k] - c->bv[b * (size_t)D + (size_t)k]) * d[k]);
             if (c->bp_mode == SPH_BP_MIRROR) kb = 1;
             else if (c->bp_mode == SPH_BP_EXTRAPOLATE && w->priv.b_sw[b] > 0) {
                 const sph_real rb = P->rho0 * c->brho[b];
-                kb = sph__kw(c->k.form, q) / w->priv.b_sw[b] * rhoi * rhoi / (rb * rb);
+                sph_real r2 = 0;
+                SPH__FOR_K(D, r2 += d[k] * d[k]);
+                kb = sph__kw(c->k.form, sph__sqrt(r2) * c->k.inv_h) / w->priv.b_sw[b] * rhoi *
+                     rhoi / (rb * rb);
             }
             SPH__FOR_K(D, A[k] += psi * fw * d[k]; dv[k] += psi * (1 + kb) * fw * d[k]);
             R += psi * fw * vd;
         }
+        if (w->priv.wg) sph__wall_grad_sum(c, i, D, w->priv.wg);
     }
     for (k = 0; k < D; ++k) dot += dv[k] * A[k];
     /* density sums are normalised by the lattice sum S (sph__stage_density_summation), so are
@@ -8426,8 +8594,7 @@ SPH__INLINE sph_real sph__iisph_Ap_one(const sph_world* w, const sph__ctx* c, si
                                        sph_real dt) {
     const sph_real* xi = c->x + i * (size_t)D;
     const sph_real* api = w->priv.ap + i * (size_t)D;
-    const sph__phase_c* P = &c->pc[c->ph[i]];
-    sph_real Ap = 0, sb[3] = {0, 0, 0};
+    sph_real Ap = 0;
     size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
     int k;
     for (kk = k0; kk < k1; ++kk) {
@@ -8439,16 +8606,8 @@ SPH__INLINE sph_real sph__iisph_Ap_one(const sph_world* w, const sph__ctx* c, si
         SPH__FOR_K(D, dd += (api[k] - apj[k]) * d[k]);
         Ap += mj * w->priv.ff_fw[kk] * dd;
     }
-    if (c->has_b) {
-        k0 = c->fb->begin[i];
-        k1 = k0 + c->fb->count[i];
-        for (kk = k0; kk < k1; ++kk) {
-            const size_t b = c->fb->idx[kk];
-            sph_real d[3] = {0, 0, 0};
-            const sph_real fw = w->priv.fb_fw[kk] * P->rho0 * c->bvol[b];
-            sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
-            SPH__FOR_K(D, sb[k] += fw * d[k]);
-        }
+    if (c->has_b) { /* positions are fixed within the solve: the walls' sum is taken once */
+        const sph_real* sb = w->priv.wg + i * (size_t)(D + 1);
         for (k = 0; k < D; ++k) Ap += api[k] * sb[k];
     }
     return Ap * (dt * dt / w->priv.lattice_sum);
@@ -8689,7 +8848,9 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
     int it = 0;
     if ((s = sph__scratch(w, &w->priv.aii, w->capacity)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.src, w->capacity)) != SPH_OK ||
-        (s = sph__scratch(w, &w->priv.ap, w->capacity * (size_t)w->dim)) != SPH_OK)
+        (s = sph__scratch(w, &w->priv.ap, w->capacity * (size_t)w->dim)) != SPH_OK ||
+        (w->nb > 0 &&
+         (s = sph__scratch(w, &w->priv.wg, w->capacity * (size_t)(w->dim + 1))) != SPH_OK))
         return s;
     if (2 * nblk > w->priv.block_cap) {
         if (!sph__grow((void**)&w->priv.block, 2 * nblk + 64, sizeof(double)))
@@ -8729,6 +8890,12 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
         else if (c.dim == 3) sph__iisph_prepare_one(w, &c, (size_t)i, 3, dt);
         else sph__iisph_prepare_one(w, &c, (size_t)i, 1, dt);
         w->p[i] = w->p[i] > 0 ? sph__warm(w) * w->p[i] : 0;
+    }
+    /* with zero wall pressure the walls' part of every pressure pass is p_i/rho_i^2 times the
+       sum the diagonal's pass took */
+    if (c.has_b) {
+        c.wg = w->priv.wg;
+        c.wg_pressure = c.bp_mode == SPH_BP_ZERO && !c.bpq && c.pgrad == SPH_PGRAD_SYMMETRIC;
     }
     if (w->def.pressure_solve == SPH_PSOLVE_CG && c.bp_mode == SPH_BP_ZERO) {
         if ((s = sph__iisph_cg(w, &c, dt, &it, &err, &errmax)) != SPH_OK) return s;
@@ -8885,20 +9052,20 @@ SPH__INLINE void sph__dfsph_factor_one(sph_world* w, const sph__ctx* c, size_t i
         for (kk = k0; kk < k1; ++kk) {
             const size_t b = c->fb->idx[kk];
             const sph_real psi = P->rho0 * c->bvol[b];
-            sph_real d[3] = {0, 0, 0}, r2 = 0, fw, q, kb = 0;
+            sph_real d[3] = {0, 0, 0}, fw = c->fb_fw[kk], kb = 0; /* the summation's */
             sph__delta_vec(c, xi, c->bx + b * (size_t)D, d, D);
-            SPH__FOR_K(D, r2 += d[k] * d[k]);
-            q = sph__sqrt(r2) * c->k.inv_h;
-            fw = c->k.norm_g * sph__kf(c->k.form, q);
-            w->priv.fb_fw[kk] = fw;
             if (c->bp_mode == SPH_BP_MIRROR) kb = 1;
             else if (c->bp_mode == SPH_BP_EXTRAPOLATE && w->priv.b_sw[b] > 0) {
                 const sph_real rb = P->rho0 * c->brho[b];
-                kb = sph__kw(c->k.form, q) / w->priv.b_sw[b] * rhoi * rhoi / (rb * rb);
+                sph_real r2 = 0;
+                SPH__FOR_K(D, r2 += d[k] * d[k]);
+                kb = sph__kw(c->k.form, sph__sqrt(r2) * c->k.inv_h) / w->priv.b_sw[b] * rhoi *
+                     rhoi / (rb * rb);
             }
             SPH__FOR_K(D, A[k] += psi * fw * d[k]; B[k] += psi * (1 + kb) * fw * d[k];
                        Bm[k] += 2 * psi * fw * d[k]);
         }
+        if (w->priv.wg) sph__wall_grad_sum(c, i, D, w->priv.wg);
     }
     for (k = 0; k < D; ++k) {
         dd += A[k] * B[k];
@@ -9020,7 +9187,9 @@ static sph_status sph__step_dfsph(sph_world* w, sph_real dt) {
         (s = sph__scratch(w, &w->priv.df_alpha_v, w->capacity)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.df_kv, w->capacity)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.df_pv, w->capacity)) != SPH_OK ||
-        (s = sph__scratch(w, &w->priv.pr2, w->capacity)) != SPH_OK)
+        (s = sph__scratch(w, &w->priv.pr2, w->capacity)) != SPH_OK ||
+        (w->nb > 0 &&
+         (s = sph__scratch(w, &w->priv.wg, w->capacity * (size_t)(w->dim + 1))) != SPH_OK))
         return s;
     s = sph__boundary_motion(w, w->time);
     if (s != SPH_OK) return s;
@@ -9046,6 +9215,11 @@ static sph_status sph__step_dfsph(sph_world* w, sph_real dt) {
     sph__stage_density_summation(w, &c);
     if (w->nb > 0) sph__stage_wall(w, &c, SPH__WALL_STATE);
     sph__dfsph_factors(w, &c);
+    if (c.has_b) { /* the walls' part of the solves' passes (sph__wall_grad_sum) */
+        c.wg = cv.wg = w->priv.wg;
+        c.wg_pressure = c.bp_mode == SPH_BP_ZERO && !c.bpq;
+        cv.wg_pressure = cv.bp_mode == SPH_BP_ZERO && !cv.bpq;
+    }
     sph__time(w, SPH_STAGE_DENSITY, &t0);
     /* divergence-free solve on v^n (Alg. 3), warm started from the rate kept in w->drho */
     SPH__OMP_FOR(w->n)
