@@ -5571,10 +5571,14 @@ SPH__INLINE sph_real sph__density_row(const sph__ctx* c, size_t i, const int D, 
                 F = sph__vand(in2, sph__vmul(sph__vmul(sph__vmul(v_m5, t), t), t));
             }
             sph__vstore(wq + m, W);
-            sph__vstore(fo + m, sph__vmul(v_norm, F));
+            /* the factors straight to the cache, the padded last lanes through a buffer */
+            if (c->ff_fw_out && m + SPH__VN <= nb)
+                sph__vstore(c->ff_fw_out + b0 + m, sph__vmul(v_norm, F));
+            else
+                sph__vstore(fo + m, sph__vmul(v_norm, F));
         }
         if (c->ff_fw_out)
-            for (m = 0; m < nb; ++m) c->ff_fw_out[b0 + m] = fo[m];
+            for (m = nb - nb % SPH__VN; m < nb; ++m) c->ff_fw_out[b0 + m] = fo[m];
         for (m = 0; m < nb; ++m) sum += c->m0 * wq[m];
     }
     return sum;
@@ -5701,19 +5705,21 @@ SPH__INLINE sph_real sph__wall_kappa(const sph__ctx* c, size_t b, size_t i, sph_
    positions kept every listed pair's grad W factor fw = norm_g F in c->ff_fw / fb_fw, so the
    pair reads it instead of a square root and the kernel (3D IISPH at 59k particles, cubic
    spline: the pass x2.7); otherwise (WCSPH, PCISPH) it evaluates F and multiplies by norm_g
-   once at the end. The two differ by rounding only. */
+   once at the end. The two differ by rounding only. fast (a compile-time constant, as
+   sph__interact_one's): one mass and no periodic direction, so the per-pair tests fold away. */
 SPH__INLINE sph_real sph__visc_norm_one(const sph__ctx* c, size_t i, const int D,
-                                        const int cached) {
+                                        const int cached, const int fast) {
     const sph_real* xi = c->x + i * (size_t)D;
     const sph_real rhati = c->rho[i] * c->pc[c->ph[i]].inv_rho0;
-    const int per = c->periodic_any, form = c->k.form;
+    const sph_real* const cm = fast ? NULL : c->m; /* fast: one mass, no periodic direction */
+    const int per = fast ? 0 : c->periodic_any, form = c->k.form;
     sph_real S = 0; /* sum_j V_j (-F_ij) r^4/(r^2 + eta^2) = d m_i, the factor norm_g in F when
                        cached, else applied at the end */
     size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
     int k;
     for (kk = k0; kk < k1; ++kk) {
         const size_t j = c->ff->idx[kk];
-        const sph_real mj = c->m ? c->m[j] : c->m0;
+        const sph_real mj = cm ? cm[j] : c->m0;
         sph_real d[3] = {0, 0, 0}, r2 = 0;
         sph__delta_vec_p(c, per, xi, c->x + j * (size_t)D, d, D);
         SPH__FOR_K(D, r2 += d[k] * d[k]);
@@ -5738,7 +5744,7 @@ SPH__INLINE sph_real sph__visc_norm_one(const sph__ctx* c, size_t i, const int D
 
 /* [writes w->priv.lapc] cached: as sph__visc_norm_one's, the viscous pass's SPH__CACHED. */
 static void sph__stage_visc_norm(sph_world* w, const sph__ctx* c, int cached) {
-    const int D = c->dim;
+    const int D = c->dim, fast = !c->m && !c->periodic_any;
     sph__idx i;
     SPH_ASSERT(c->lapc && w->priv.lapc_cap >= w->n);
     SPH_ASSERT(!cached || (c->ff_fw && (c->fb_fw || !c->has_b)));
@@ -5746,9 +5752,13 @@ static void sph__stage_visc_norm(sph_world* w, const sph__ctx* c, int cached) {
     for (i = 0; i < (sph__idx)w->n; ++i) {
         const size_t q = (size_t)i;
         const sph_real m =
-            D == 2   ? (cached ? sph__visc_norm_one(c, q, 2, 1) : sph__visc_norm_one(c, q, 2, 0))
-            : D == 3 ? (cached ? sph__visc_norm_one(c, q, 3, 1) : sph__visc_norm_one(c, q, 3, 0))
-                     : sph__visc_norm_one(c, q, 1, cached);
+            D == 2   ? (!cached ? sph__visc_norm_one(c, q, 2, 0, 0)
+                        : fast  ? sph__visc_norm_one(c, q, 2, 1, 1)
+                                : sph__visc_norm_one(c, q, 2, 1, 0))
+            : D == 3 ? (!cached ? sph__visc_norm_one(c, q, 3, 0, 0)
+                        : fast  ? sph__visc_norm_one(c, q, 3, 1, 1)
+                                : sph__visc_norm_one(c, q, 3, 1, 0))
+                     : sph__visc_norm_one(c, q, 1, cached, 0);
         w->priv.lapc[i] = m > SPH__R(0.5) ? 1 / m : 2;
     }
 }
@@ -8539,7 +8549,9 @@ SPH__INLINE void sph__wall_grad_sum(const sph__ctx* c, size_t i, const int D, sp
 
 /* Diagonal and source term of fluid particle i (one neighbour pass). */
 SPH__INLINE void sph__iisph_prepare_one(const sph_world* w, const sph__ctx* c, size_t i, const int D,
-                                        sph_real dt) {
+                                        sph_real dt, const int fast) {
+    const sph_real* const cm = fast ? NULL : c->m; /* fast: as sph__visc_norm_one's */
+    const int per = fast ? 0 : c->periodic_any;
     const sph_real* xi = c->x + i * (size_t)D;
     const sph_real* vi = c->v + i * (size_t)D;
     const sph__phase_c* P = &c->pc[c->ph[i]];
@@ -8549,9 +8561,9 @@ SPH__INLINE void sph__iisph_prepare_one(const sph_world* w, const sph__ctx* c, s
     int k;
     for (kk = k0; kk < k1; ++kk) {
         const size_t j = c->ff->idx[kk];
-        const sph_real mj = c->m ? c->m[j] : c->m0;
+        const sph_real mj = cm ? cm[j] : c->m0;
         sph_real d[3] = {0, 0, 0}, r2 = 0, vd = 0, fw;
-        sph__delta_vec(c, xi, c->x + j * (size_t)D, d, D);
+        sph__delta_vec_p(c, per, xi, c->x + j * (size_t)D, d, D);
         SPH__FOR_K(D, r2 += d[k] * d[k]; vd += (vi[k] - c->v[j * (size_t)D + (size_t)k]) * d[k]);
         fw = c->ff_fw[kk]; /* from the density summation; reused by every iteration */
         SPH__FOR_K(D, A[k] += mj * fw * d[k]; dv[k] += mj * fw * d[k]);
@@ -8591,18 +8603,20 @@ SPH__INLINE void sph__iisph_prepare_one(const sph_world* w, const sph__ctx* c, s
 /* (A p)_i [kg/m^3] from the pressure accelerations a^p in w->priv.ap (Ihmsen et al. 2014 eq. 14:
    the density change the pressure's displacements dt^2 a^p cause). */
 SPH__INLINE sph_real sph__iisph_Ap_one(const sph_world* w, const sph__ctx* c, size_t i, const int D,
-                                       sph_real dt) {
+                                       sph_real dt, const int fast) {
     const sph_real* xi = c->x + i * (size_t)D;
     const sph_real* api = w->priv.ap + i * (size_t)D;
+    const sph_real* const cm = fast ? NULL : c->m; /* fast: as sph__visc_norm_one's */
+    const int per = fast ? 0 : c->periodic_any;
     sph_real Ap = 0;
     size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
     int k;
     for (kk = k0; kk < k1; ++kk) {
         const size_t j = c->ff->idx[kk];
         const sph_real* apj = w->priv.ap + j * (size_t)D;
-        const sph_real mj = c->m ? c->m[j] : c->m0;
+        const sph_real mj = cm ? cm[j] : c->m0;
         sph_real d[3] = {0, 0, 0}, dd = 0;
-        sph__delta_vec(c, xi, c->x + j * (size_t)D, d, D);
+        sph__delta_vec_p(c, per, xi, c->x + j * (size_t)D, d, D);
         SPH__FOR_K(D, dd += (api[k] - apj[k]) * d[k]);
         Ap += mj * w->priv.ff_fw[kk] * dd;
     }
@@ -8616,8 +8630,8 @@ SPH__INLINE sph_real sph__iisph_Ap_one(const sph_world* w, const sph__ctx* c, si
 /* The Jacobi update of p_i (in place: A p reads only accelerations) and the predicted
    compression before the update. */
 SPH__INLINE double sph__iisph_update_one(sph_world* w, const sph__ctx* c, size_t i, const int D,
-                                         sph_real dt, sph_real omega) {
-    const sph_real Ap = sph__iisph_Ap_one(w, c, i, D, dt), aii = w->priv.aii[i];
+                                         sph_real dt, sph_real omega, const int fast) {
+    const sph_real Ap = sph__iisph_Ap_one(w, c, i, D, dt, fast), aii = w->priv.aii[i];
     const sph_real err = (Ap - w->priv.src[i]) * c->pc[c->ph[i]].inv_rho0;
     const sph_real p = aii < 0 ? w->p[i] + omega * (w->priv.src[i] - Ap) / aii : 0;
     w->p[i] = p > 0 ? p : 0;
@@ -8630,6 +8644,7 @@ SPH__INLINE double sph__iisph_update_one(sph_world* w, const sph__ctx* c, size_t
 static double sph__iisph_sweep(sph_world* w, const sph__ctx* c, sph_real dt, double* emax) {
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
     const sph_real omega = (sph_real)w->stats.omega;
+    const int fast = !c->m && !c->periodic_any;
     double sum = 0;
     sph__idx blk;
     size_t q;
@@ -8640,9 +8655,11 @@ static double sph__iisph_sweep(sph_world* w, const sph__ctx* c, sph_real dt, dou
         double e = 0, m = 0, ei;
         size_t i;
         for (i = i0; i < i1; ++i) {
-            ei = c->dim == 2   ? sph__iisph_update_one(w, c, i, 2, dt, omega)
-                 : c->dim == 3 ? sph__iisph_update_one(w, c, i, 3, dt, omega)
-                               : sph__iisph_update_one(w, c, i, 1, dt, omega);
+            ei = c->dim == 2   ? (fast ? sph__iisph_update_one(w, c, i, 2, dt, omega, 1)
+                                       : sph__iisph_update_one(w, c, i, 2, dt, omega, 0))
+                 : c->dim == 3 ? (fast ? sph__iisph_update_one(w, c, i, 3, dt, omega, 1)
+                                       : sph__iisph_update_one(w, c, i, 3, dt, omega, 0))
+                               : sph__iisph_update_one(w, c, i, 1, dt, omega, 0);
             e += ei;
             if (ei > m) m = ei;
         }
@@ -8700,9 +8717,9 @@ static void sph__iisph_cg_product(sph_world* w, const sph__ctx* c, sph_real dt, 
     sph__stage_interact(w, &cx, SPH__PRESSURE | SPH__SET | SPH__CACHED, w->priv.ap);
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i)
-        out[i] = c->dim == 2   ? sph__iisph_Ap_one(w, c, (size_t)i, 2, dt)
-                 : c->dim == 3 ? sph__iisph_Ap_one(w, c, (size_t)i, 3, dt)
-                               : sph__iisph_Ap_one(w, c, (size_t)i, 1, dt);
+        out[i] = c->dim == 2   ? sph__iisph_Ap_one(w, c, (size_t)i, 2, dt, 0)
+                 : c->dim == 3 ? sph__iisph_Ap_one(w, c, (size_t)i, 3, dt, 0)
+                               : sph__iisph_Ap_one(w, c, (size_t)i, 1, dt, 0);
 }
 
 /* Fixed-order block sums: returns <a, b>_D over the active set (b = NULL: the preconditioned
@@ -8886,9 +8903,12 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
     /* diagonal, source, warm start */
     SPH__OMP_FOR(w->n)
     for (i = 0; i < (sph__idx)w->n; ++i) {
-        if (c.dim == 2) sph__iisph_prepare_one(w, &c, (size_t)i, 2, dt);
-        else if (c.dim == 3) sph__iisph_prepare_one(w, &c, (size_t)i, 3, dt);
-        else sph__iisph_prepare_one(w, &c, (size_t)i, 1, dt);
+        const int fast = !c.m && !c.periodic_any;
+        if (c.dim == 2 && fast) sph__iisph_prepare_one(w, &c, (size_t)i, 2, dt, 1);
+        else if (c.dim == 2) sph__iisph_prepare_one(w, &c, (size_t)i, 2, dt, 0);
+        else if (c.dim == 3 && fast) sph__iisph_prepare_one(w, &c, (size_t)i, 3, dt, 1);
+        else if (c.dim == 3) sph__iisph_prepare_one(w, &c, (size_t)i, 3, dt, 0);
+        else sph__iisph_prepare_one(w, &c, (size_t)i, 1, dt, 0);
         w->p[i] = w->p[i] > 0 ? sph__warm(w) * w->p[i] : 0;
     }
     /* with zero wall pressure the walls' part of every pressure pass is p_i/rho_i^2 times the
@@ -8922,7 +8942,7 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
         size_t q;
         sph_real emax = -1;
         for (q = 0; q < w->n; ++q) {
-            const sph_real e = (sph__iisph_Ap_one(w, &c, q, c.dim, dt) - w->priv.src[q]) *
+            const sph_real e = (sph__iisph_Ap_one(w, &c, q, c.dim, dt, 0) - w->priv.src[q]) *
                                c.pc[c.ph[q]].inv_rho0;
             if (e > emax) { emax = e; worst = q; }
         }
