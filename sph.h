@@ -5869,19 +5869,6 @@ SPH__INLINE sph_real sph__delta_across(const sph__ctx* c, const sph__phase_c* P,
     return (pi - pj) / (Ki > Kj ? Ki : Kj);
 }
 
-
-/* sph__interact_one's fluid pairs on the fast path (viscous passes, with or without pressure,
-   STORE or CACHED), in batches of SPH__ROW neighbours: a gather loop reads each neighbour in
-   list order, a packed loop (SPH__VN lanes) does the square root and the kernel (or reads the
-   cached factor), the division of the laminar term and the two of the artificial viscosity
-   (branch-free: a receding pair's lane is masked to +0, and s - (+0) is s), and a last loop
-   adds the pair forces in list order. Every lane computes the plain loop's expressions in the
-   plain loop's order and the sums are taken in the same order, so the result has the same
-   bits. The packed loop replaces a branch on the sign of v_ij . x_ij that went either way at
-   random; for laminar viscosity it saves the plain loop's per-pair tests and halves the
-   divisions of its term (3D IISPH at 59k particles: the viscous pass, without the
-   normalisation, x1.45).
-   [adds to ai, m/s^2] */
 /* sph__accel_row's last loop: ai[k] += lm_m dv[k][m] (if lm) + fs_m dd[k][m] over the row, in
    list order. Not inlined on purpose: inlined into the passes, gcc kept one of the three sums
    in memory, so every pair waited on a store and a reload (3D IISPH at 59k particles: a fifth
@@ -5913,6 +5900,18 @@ SPH__NOINLINE void sph__row_sum(const int D, size_t nb, const sph_real* lm,
     if (D > 2) ai[2] = a2;
 }
 
+/* sph__interact_one's fluid pairs on the fast path (viscous passes, with or without pressure,
+   STORE or CACHED), in batches of SPH__ROW neighbours: a gather loop reads each neighbour in
+   list order, a packed loop (SPH__VN lanes) does the square root and the kernel (or reads the
+   cached factor), the division of the laminar term and the two of the artificial viscosity
+   (branch-free: a receding pair's lane is masked to +0, and s - (+0) is s), and a last loop
+   adds the pair forces in list order. Every lane computes the plain loop's expressions in the
+   plain loop's order and the sums are taken in the same order, so the result has the same
+   bits. The packed loop replaces a branch on the sign of v_ij . x_ij that went either way at
+   random; for laminar viscosity it saves the plain loop's per-pair tests and halves the
+   divisions of its term (3D IISPH at 59k particles: the viscous pass, without the
+   normalisation, x1.45).
+   [adds to ai, m/s^2] */
 SPH__INLINE void sph__accel_row(const sph__ctx* c, size_t i, const int D, const int flags,
                                 sph_real* ai) {
     const sph_real* xi = c->x + i * (size_t)D;
