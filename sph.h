@@ -5524,8 +5524,8 @@ SPH__INLINE sph_real sph__wall_sum(const sph__ctx* c, size_t i, const sph_real* 
    both kernel functions in packed lanes, the cubic's two pieces computed in every lane and the
    one that applies kept (lanes outside a piece are masked to +0, and x + (+0) is x), then the
    masses summed in list order. The same expressions in the same order as sph__kw and sph__kf,
-   so the same bits (3D IISPH at 59k particles: the scalar loop's branch on q < 1 went either
-   way at random). Returns sum_j W_ij / norm_w (without m_j) and stores the grad W factors. */
+   so the same bits, without the scalar loop's branch on q < 1 per pair. Returns
+   sum_j m_j W_ij / norm_w (every m_j = m0 here) and stores the grad W factors. */
 SPH__INLINE sph_real sph__density_row(const sph__ctx* c, size_t i, const int D, const int form) {
     const sph_real* xi = c->x + i * (size_t)D;
     const sph_real far = 4 * c->k.radius * c->k.radius; /* padding lanes: beyond the support */
@@ -5871,8 +5871,9 @@ SPH__INLINE sph_real sph__delta_across(const sph__ctx* c, const sph__phase_c* P,
 
 /* sph__accel_row's last loop: ai[k] += lm_m dv[k][m] (if lm) + fs_m dd[k][m] over the row, in
    list order. Not inlined on purpose: inlined into the passes, gcc kept one of the three sums
-   in memory, so every pair waited on a store and a reload (3D IISPH at 59k particles: a fifth
-   of the time of all its neighbour passes); here the sums live in registers. */
+   in memory, so every pair waited on a store and a reload (3D IISPH at 59k particles, perf:
+   22-24 % of the samples in the neighbour passes of sph__stage_interact, about 7 % of the run);
+   here the sums live in registers. */
 SPH__NOINLINE void sph__row_sum(const int D, size_t nb, const sph_real* lm,
                                 sph_real (*dv)[SPH__ROW], const sph_real* fs,
                                 sph_real (*dd)[SPH__ROW], sph_real* ai) {
@@ -8525,8 +8526,7 @@ SPHDEF sph_status sph_step_pcisph(sph_world* w, sph_real dt) {
    solve the positions and wall velocities do not change, so a pass with zero wall pressure
    adds -(p_i/rho_i^2) times the first sum (Akinci et al. 2012's wall term) and the density
    rate v_i . (first) - (second), where it would run over the wall neighbours in every
-   iteration (3D dam break: a third of the water rests on the floor by t = 1 s). Reading the
-   sums changes the order of the additions, not the terms. */
+   iteration. Reading the sums changes the order of the additions, not the terms. */
 SPH__INLINE void sph__wall_grad_sum(const sph__ctx* c, size_t i, const int D, sph_real* out) {
     const sph_real* xi = c->x + i * (size_t)D;
     const sph_real rho0 = c->pc[c->ph[i]].rho0;
