@@ -137,8 +137,9 @@ int main(void) {
    SOLVER: WCSPH (sph_step_wcsph, or sph_step / sph_advance with def.solver)
    Pressure from a stiff equation of state per phase: Tait, p = B((rho/rho0)^gamma - 1) with
    B = rho0 c0^2 / gamma and gamma = 7, or linear, p = c0^2 (rho - rho0). A sound speed of 0
-   asks for c0 = 10 max(sqrt(2 |g| H), |v|max), chosen at the first step, so density varies by
-   about 1 %. Density by continuity (default) with delta-SPH diffusion (Molteni & Colagrossi
+   asks for c0 = 10 max(sqrt(2 |g| H), |v|max), H the height the fluid can fall (its extent
+   along gravity, plus the gap down to the walls below it), chosen at the first step, so density
+   varies by about 1 %. Density by continuity (default) with delta-SPH diffusion (Molteni & Colagrossi
    2009, delta = 0.1), by summation, or by Ott & Schnetter's particle-density continuity for
    phases of very different density; negative pressures are clamped unless the domain is
    periodic in every direction (no tension at a free surface, def.clamp: see sph__clamps for
@@ -1130,9 +1131,9 @@ typedef struct sph_world_def {
     sph_real max_speed;        /* blow-up if |v| exceeds it [m/s]; 0 (default) = the largest c0
                                   (WCSPH), 10 c0 (compressible step), 0.5 c0 + 2 |v_wall|max
                                   for PCISPH, IISPH, DFSPH and PBF (five times the free-fall
-                                  speed over the fluid's height or the fastest start with the
-                                  automatic c0; a violent impact's jet can pass it: raise it
-                                  there); no check while no c0 is set; >= 0                     */
+                                  speed over the height the fluid can fall, or the fastest
+                                  start, with the automatic c0; a violent impact's jet can pass
+                                  it: raise it there); no check while no c0 is set; >= 0       */
     sph_real max_displacement; /* blow-up if a fluid particle moves more than this many spacings
                                   dx in one step [-] (a large step through a thin wall, or a
                                   runaway); default 1; 0 = no check; >= 0                        */
@@ -1186,8 +1187,9 @@ typedef struct sph_phase {
     sph_real rest_density;   /* rho0 [kg/m^3]; required, finite, > 0                              */
     sph_real viscosity;      /* kinematic viscosity nu [m^2/s]; 0 = inviscid (default); >= 0      */
     sph_real sound_speed;    /* c0 [m/s] at rest density; >= 0; 0 = automatic: 10 * max(sqrt(2
-                                |g| H), |v|max), H = the phase's extent along gravity plus dx,
-                                chosen when a step (or sph_stable_dt, sph_set_hydrostatic) first
+                                |g| H), |v|max), H = the phase's extent along gravity plus dx
+                                plus the fall from the fluid's lowest particle to the walls
+                                below it (see sph__resolve_sound_speed), chosen when a step (or sph_stable_dt, sph_set_hydrostatic) first
                                 finds particles of the phase; without gravity and motion that
                                 fails (SPH_ERR_ARG) for WCSPH and the compressible step, and
                                 IISPH and PCISPH run without c0. Required (> 0) for a stiffened
@@ -4837,17 +4839,45 @@ static void sph__time(sph_world* w, sph_stage s, double* t0) {
 }
 
 /* Sound speeds left at 0 are chosen once, when the phase first has particles: c0 = 10 U with
-   U = max(sqrt(2 |g| H), |v|max), so the density varies by about 1 % (Monaghan 1994). */
+   U = max(sqrt(2 |g| H), |v|max), so the density varies by about 1 % (Monaghan 1994). U is the
+   fastest the phase can move, so H is the height it can fall: its own height (highest particle
+   to lowest, along gravity) plus the gap below the whole fluid, from its lowest particle of any
+   phase down to the lowest boundary particle less a wall's depth, R + dx (the walls of
+   sph_add_wall_box are ceil(R / dx) layers deep, so a fluid resting on them has no gap; a light
+   layer over a heavy one falls no further than its own height). Measured without the gap (a 2D
+   disc of water, radius 0.15 m, its lowest point 0.55 m above the floor of a 1 m box, dx 0.01,
+   the defaults, frames of 0.02 s): c0 was set by the disc's own 0.3 m, 24.7 m/s, the jets of its
+   impact on the floor reached 12.2-14.0 m/s, over the incompressible solvers' bound 0.5 c0
+   (sph__integrate_with), and every solver failed at 0.34 s. With the gap (c0 41.3 m/s) IISPH,
+   DFSPH, PBF and both PCISPH run to 1.5 s; WCSPH still fails at 0.36 s, reported: its jets
+   (17 m/s) meet the side walls 20 % compressed (def.max_compression). */
 static sph_status sph__resolve_sound_speed(sph_world* w) {
     const size_t D = (size_t)w->dim;
-    double gmag = 0, ghat[3] = {0, 0, 0};
+    double gmag = 0, ghat[3] = {0, 0, 0}, sbmax = -1e300, sfmax = -1e300, gap = 0;
+    size_t b, i;
     int q, k;
     for (k = 0; k < w->dim; ++k) gmag += (double)w->def.gravity[k] * (double)w->def.gravity[k];
     gmag = sqrt(gmag);
     for (k = 0; k < w->dim; ++k) ghat[k] = gmag > 0 ? (double)w->def.gravity[k] / gmag : 0;
+    for (q = 0; q < w->nphase; ++q)
+        if (!(w->phases[q].sound_speed > 0) && w->phases[q].eos != SPH_EOS_IDEAL_GAS) break;
+    if (q < w->nphase && w->nb > 0) { /* some phase is automatic: the gap below the fluid */
+        for (b = 0; b < w->nb; ++b) {
+            double s = 0;
+            for (k = 0; k < w->dim; ++k) s += (double)w->b_x[b * D + (size_t)k] * ghat[k];
+            if (s > sbmax) sbmax = s;
+        }
+        for (i = 0; i < w->n; ++i) {
+            double s = 0;
+            for (k = 0; k < w->dim; ++k) s += (double)w->x[i * D + (size_t)k] * ghat[k];
+            if (s > sfmax) sfmax = s;
+        }
+        gap = sbmax - (double)(w->kernel.radius + w->dx) - sfmax;
+        if (!(gap > 0)) gap = 0;
+    }
     for (q = 0; q < w->nphase; ++q) {
         double smin = 1e300, smax = -1e300, v2max = 0, U, c0;
-        size_t i, count = 0;
+        size_t count = 0;
         if (w->phases[q].sound_speed > 0 || w->phases[q].eos == SPH_EOS_IDEAL_GAS) continue;
         for (i = 0; i < w->n; ++i) {
             double s = 0, v2 = 0;
@@ -4862,7 +4892,7 @@ static sph_status sph__resolve_sound_speed(sph_world* w) {
             if (v2 > v2max) v2max = v2;
         }
         if (count == 0) continue;
-        U = sqrt(2 * gmag * (smax - smin + (double)w->dx));
+        U = sqrt(2 * gmag * (smax - smin + gap + (double)w->dx));
         if (sqrt(v2max) > U) U = sqrt(v2max);
         c0 = 10 * U;
         if (!(c0 > 0) || !sph__finite(c0))
@@ -6861,9 +6891,11 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
            only a runaway is a blow-up */
         if (w->priv.solver == SPH_SOLVER_COMPRESSIBLE) vlim *= 10;
         /* the incompressible solvers have no sound speed that bounds the flow: the automatic c0
-           is 10 max(sqrt(2 |g| H), |v|max), so 0.5 c0 is five times the free-fall speed over the
-           fluid's height or the fastest start (a dam break's splash reached 2.3 times the
-           first; a block of water thrown at 5 m/s against a wall ran up it at 22-27 m/s, 4.4-5.4
+           is 10 max(sqrt(2 |g| H), |v|max), so 0.5 c0 is five times the free-fall speed over
+           the height the fluid can fall (sph__resolve_sound_speed) or the fastest start (a dam
+           break's splash reached 2.3 times the first, the jets of a disc dropped onto a floor
+           3.7-4.6 times, 15.4-19.0 m/s at frame ends in the scene of tests/test_scenes.c's
+           drop_2d at dx 0.01, IISPH, DFSPH, PBF and both PCISPH; a block of water thrown at 5 m/s against a wall ran up it at 22-27 m/s, 4.4-5.4
            times the second, which fails IISPH and DFSPH there, reported: raise def.max_speed for
            such impacts). The bound c0 instead let a runaway IISPH step grind on at a
            thousandth of its stable step for 4000 sub-steps before it failed (a fuzzed world of
