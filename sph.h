@@ -1189,7 +1189,10 @@ typedef struct sph_phase {
     sph_real sound_speed;    /* c0 [m/s] at rest density; >= 0; 0 = automatic: 10 * max(sqrt(2
                                 |g| H), |v|max), H = the phase's extent along gravity plus dx
                                 plus the fall from the fluid's lowest particle to the walls
-                                below it (see sph__resolve_sound_speed), chosen when a step (or sph_stable_dt, sph_set_hydrostatic) first
+                                below it (sph__resolve_sound_speed; walls far below that the
+                                fluid cannot reach raise it too, and WCSPH's step falls with
+                                1/c0: set it then), chosen when a step (or sph_stable_dt,
+                                sph_set_hydrostatic) first
                                 finds particles of the phase; without gravity and motion that
                                 fails (SPH_ERR_ARG) for WCSPH and the compressible step, and
                                 IISPH and PCISPH run without c0. Required (> 0) for a stiffened
@@ -4846,9 +4849,9 @@ static void sph__time(sph_world* w, sph_stage s, double* t0) {
    sph_add_wall_box are ceil(R / dx) layers deep, so a fluid resting on them has no gap; a light
    layer over a heavy one falls no further than its own height). Measured without the gap (a 2D
    disc of water, radius 0.15 m, its lowest point 0.55 m above the floor of a 1 m box, dx 0.01,
-   the defaults, frames of 0.02 s): c0 was set by the disc's own 0.3 m, 24.7 m/s, the jets of its
+   the defaults, frames of 0.02 s): c0 was set by the disc's own 0.3 m, 24.3 m/s, the jets of its
    impact on the floor reached 12.2-14.0 m/s, over the incompressible solvers' bound 0.5 c0
-   (sph__integrate_with), and every solver failed at 0.34 s. With the gap (c0 41.3 m/s) IISPH,
+   (sph__integrate_with), and every solver failed at 0.34 s. With the gap (c0 40.7 m/s) IISPH,
    DFSPH, PBF and both PCISPH run to 1.5 s; WCSPH still fails at 0.36 s, reported: its jets
    (17 m/s) meet the side walls 20 % compressed (def.max_compression). */
 static sph_status sph__resolve_sound_speed(sph_world* w) {
@@ -6893,10 +6896,10 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
         /* the incompressible solvers have no sound speed that bounds the flow: the automatic c0
            is 10 max(sqrt(2 |g| H), |v|max), so 0.5 c0 is five times the free-fall speed over
            the height the fluid can fall (sph__resolve_sound_speed) or the fastest start (a dam
-           break's splash reached 2.3 times the first, the jets of a disc dropped onto a floor
-           3.7-4.6 times, 15.4-19.0 m/s at frame ends in the scene of tests/test_scenes.c's
-           drop_2d at dx 0.01, IISPH, DFSPH, PBF and both PCISPH; a block of water thrown at 5 m/s against a wall ran up it at 22-27 m/s, 4.4-5.4
-           times the second, which fails IISPH and DFSPH there, reported: raise def.max_speed for
+           break's splash reached 2.3 times the first; the jets of a disc dropped onto a floor
+           3.8-4.7 times, 15.4-19.0 m/s at frame ends with IISPH, DFSPH, PBF and both PCISPH,
+           the disc of sph__resolve_sound_speed's measurement; a block of water thrown at 5 m/s
+           against a wall ran up it at 22-27 m/s, 4.4-5.4 times the second, which fails IISPH and DFSPH there, reported: raise def.max_speed for
            such impacts). The bound c0 instead let a runaway IISPH step grind on at a
            thousandth of its stable step for 4000 sub-steps before it failed (a fuzzed world of
            320 particles: 50 s under the sanitizers against 0.06 s), so it stays at half; walls
