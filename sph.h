@@ -1129,11 +1129,12 @@ typedef struct sph_world_def {
     sph_real max_compression;  /* blow-up if rho/rho0 - 1 exceeds it [-]; default 0.2; 0 = no
                                   check; >= 0; not applied to gas phases                         */
     sph_real max_speed;        /* blow-up if |v| exceeds it [m/s]; 0 (default) = the largest c0
-                                  (WCSPH), 10 c0 (compressible step), 0.5 c0 + 2 |v_wall|max
-                                  for PCISPH, IISPH, DFSPH and PBF (five times the free-fall
-                                  speed over the height the fluid can fall, or the fastest
-                                  start, with the automatic c0; a violent impact's jet can pass
-                                  it: raise it there); no check while no c0 is set; >= 0       */
+                                  (WCSPH), 10 c0 (compressible step), c0 + 2 |v_wall|max for
+                                  PCISPH, IISPH, DFSPH and PBF (ten times the free-fall speed
+                                  over the height the fluid can fall, or the fastest start,
+                                  with the automatic c0; the jets of impacts grow with the
+                                  resolution and can pass it: raise it there); no check while
+                                  no c0 is set; >= 0                                           */
     sph_real max_displacement; /* blow-up if a fluid particle moves more than this many spacings
                                   dx in one step [-] (a large step through a thin wall, or a
                                   runaway); default 1; 0 = no check; >= 0                        */
@@ -4850,7 +4851,7 @@ static void sph__time(sph_world* w, sph_stage s, double* t0) {
    layer over a heavy one falls no further than its own height). Measured without the gap (a 2D
    disc of water, radius 0.15 m, its lowest point 0.55 m above the floor of a 1 m box, dx 0.01,
    the defaults, frames of 0.02 s): c0 was set by the disc's own 0.3 m, 24.3 m/s, the jets of its
-   impact on the floor reached 12.2-14.0 m/s, over the incompressible solvers' bound 0.5 c0
+   impact on the floor reached 12.2-14.0 m/s, over the incompressible solvers' bound then, 0.5 c0
    (sph__integrate_with), and every solver failed at 0.34 s. With the gap (c0 40.7 m/s) IISPH,
    DFSPH, PBF and both PCISPH run to 1.5 s; WCSPH still fails at 0.36 s, reported: its jets
    (17 m/s) meet the side walls 20 % compressed (def.max_compression). */
@@ -6894,17 +6895,20 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
            only a runaway is a blow-up */
         if (w->priv.solver == SPH_SOLVER_COMPRESSIBLE) vlim *= 10;
         /* the incompressible solvers have no sound speed that bounds the flow: the automatic c0
-           is 10 max(sqrt(2 |g| H), |v|max), so 0.5 c0 is five times the free-fall speed over
-           the height the fluid can fall (sph__resolve_sound_speed) or the fastest start (a dam
-           break's splash reached 2.3 times the first; the jets of a disc dropped onto a floor
-           3.8-4.7 times, 15.4-19.0 m/s at frame ends with IISPH, DFSPH, PBF and both PCISPH,
-           the disc of sph__resolve_sound_speed's measurement; a block of water thrown at 5 m/s
-           against a wall ran up it at 22-27 m/s, 4.4-5.4 times the second, which fails IISPH and DFSPH there, reported: raise def.max_speed for
-           such impacts). The bound c0 instead let a runaway IISPH step grind on at a
-           thousandth of its stable step for 4000 sub-steps before it failed (a fuzzed world of
-           320 particles: 50 s under the sanitizers against 0.06 s), so it stays at half; walls
-           move the fluid at up to twice their speed (a piston's reflected wave), which is
-           added */
+           is 10 max(sqrt(2 |g| H), |v|max), ten times the free-fall speed over the height the
+           fluid can fall (sph__resolve_sound_speed) or the fastest start, and the bound is c0.
+           The jets of an impact grow with the resolution (a round body's contact line starts
+           infinitely fast, Wagner 1932): the disc of sph__resolve_sound_speed's measurement
+           threw them at 3.8-4.7 times the free-fall speed at dx 0.01 (15.4-19.0 m/s at frame
+           ends, IISPH, DFSPH, PBF and both PCISPH) and 5.1-7.1 times at dx 0.005 (20.9-28.8
+           m/s), where the bound 0.5 c0 used before failed IISPH, DFSPH and PBF at 0.34 s; a
+           dam break's splash reached 2.3 times, a block thrown at 5 m/s against a wall ran up it
+           at 4.4-5.4 times its speed. That bound had been chosen because c0 let a runaway IISPH
+           step grind on at a thousandth of its stable step for 4000 sub-steps (a fuzzed world
+           of 320 particles, tests/fuzz_corpus/regressions/api/speed-bound-grind.bin: 50 s under
+           the sanitizers against 0.06 s); with c0 that input now takes 0.08 s under ASan +
+           UBSan (its sph_advance stops at def.max_substeps). Walls move the fluid at up to
+           twice their speed (a piston's reflected wave), which is added */
         if (sph__incompressible(w->priv.solver) && vlim > 0) {
             double vb2 = 0;
             size_t b;
@@ -6913,7 +6917,7 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 for (k = 0; k < D; ++k) v2 += (double)w->b_v[b + (size_t)k] * (double)w->b_v[b + (size_t)k];
                 if (v2 > vb2) vb2 = v2;
             }
-            vlim = (sph_real)(0.5 * (double)vlim + 2 * sqrt(vb2));
+            vlim = (sph_real)((double)vlim + 2 * sqrt(vb2));
         }
     }
     if (nblk * SPH__RED_N > w->priv.block_cap) {
