@@ -529,8 +529,8 @@ static void test_drum_3d(void) { sc_defaults(SC_DRUM, 3, 0.04, 1.0); }
 /* a disc or ball of water dropped onto the floor: while the automatic sound speed came from the
    fluid's own height only (24.3 m/s for the disc), the jets of the impact (12.2-14.0 m/s in 2D at
    dx 0.01, 3.7-4.3 times the impact speed) passed the incompressible solvers' speed bound, then
-   half of it, and every solver failed at 0.34 s; here WCSPH failed at 0.35 s in 2D, WCSPH and
-   enhanced PCISPH at 0.45 and 0.35 s in 3D. The automatic sound speed now counts the fall to the
+   half of it, and every solver failed at 0.34 s; here WCSPH failed after 0.35 s in 2D, WCSPH and
+   enhanced PCISPH after 0.45 and 0.35 s in 3D. The automatic sound speed now counts the fall to the
    floor (sph_phase.sound_speed) and the bound is c0 (def.max_speed) */
 static void test_drop_2d(void) { sc_defaults(SC_DROP, 2, 0.02, 1.0); }
 static void test_drop_3d(void) { sc_defaults(SC_DROP, 3, 0.015, 0.5); }
