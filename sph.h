@@ -139,8 +139,8 @@ int main(void) {
    B = rho0 c0^2 / gamma and gamma = 7, or linear, p = c0^2 (rho - rho0). A sound speed of 0
    asks for c0 = 10 max(sqrt(2 |g| H), |v|max), H the height the fluid can fall (its extent
    along gravity, plus the gap down to the walls below it), chosen at the first step, so density
-   varies by about 1 %. Density by continuity (default) with delta-SPH diffusion (Molteni & Colagrossi
-   2009, delta = 0.1), by summation, or by Ott & Schnetter's particle-density continuity for
+   varies by about 1 %. Density by continuity (default) with delta-SPH diffusion (Molteni &
+   Colagrossi 2009, delta = 0.1), by summation, or by Ott & Schnetter's particle-density continuity for
    phases of very different density; negative pressures are clamped unless the domain is
    periodic in every direction (no tension at a free surface, def.clamp: see sph__clamps for
    why, and sph__rho_floor for the least carried density). Phases: with particle
