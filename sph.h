@@ -4857,28 +4857,12 @@ static void sph__time(sph_world* w, sph_stage s, double* t0) {
    (17 m/s) meet the side walls 20 % compressed (def.max_compression). */
 static sph_status sph__resolve_sound_speed(sph_world* w) {
     const size_t D = (size_t)w->dim;
-    double gmag = 0, ghat[3] = {0, 0, 0}, sbmax = -1e300, sfmax = -1e300, gap = 0;
+    double gmag = 0, ghat[3] = {0, 0, 0}, gap = -1; /* gap < 0: not measured yet */
     size_t b, i;
     int q, k;
     for (k = 0; k < w->dim; ++k) gmag += (double)w->def.gravity[k] * (double)w->def.gravity[k];
     gmag = sqrt(gmag);
     for (k = 0; k < w->dim; ++k) ghat[k] = gmag > 0 ? (double)w->def.gravity[k] / gmag : 0;
-    for (q = 0; q < w->nphase; ++q)
-        if (!(w->phases[q].sound_speed > 0) && w->phases[q].eos != SPH_EOS_IDEAL_GAS) break;
-    if (q < w->nphase && w->nb > 0) { /* some phase is automatic: the gap below the fluid */
-        for (b = 0; b < w->nb; ++b) {
-            double s = 0;
-            for (k = 0; k < w->dim; ++k) s += (double)w->b_x[b * D + (size_t)k] * ghat[k];
-            if (s > sbmax) sbmax = s;
-        }
-        for (i = 0; i < w->n; ++i) {
-            double s = 0;
-            for (k = 0; k < w->dim; ++k) s += (double)w->x[i * D + (size_t)k] * ghat[k];
-            if (s > sfmax) sfmax = s;
-        }
-        gap = sbmax - (double)(w->kernel.radius + w->dx) - sfmax;
-        if (!(gap > 0)) gap = 0;
-    }
     for (q = 0; q < w->nphase; ++q) {
         double smin = 1e300, smax = -1e300, v2max = 0, U, c0;
         size_t count = 0;
@@ -4896,6 +4880,22 @@ static sph_status sph__resolve_sound_speed(sph_world* w) {
             if (v2 > v2max) v2max = v2;
         }
         if (count == 0) continue;
+        if (gap < 0) { /* the gap below the fluid: once a call, when a phase is resolved now */
+            double sbmax = -1e300, sfmax = -1e300;
+            gap = 0;
+            for (b = 0; gmag > 0 && b < w->nb; ++b) {
+                double s = 0;
+                for (k = 0; k < w->dim; ++k) s += (double)w->b_x[b * D + (size_t)k] * ghat[k];
+                if (s > sbmax) sbmax = s;
+            }
+            for (i = 0; w->nb > 0 && gmag > 0 && i < w->n; ++i) {
+                double s = 0;
+                for (k = 0; k < w->dim; ++k) s += (double)w->x[i * D + (size_t)k] * ghat[k];
+                if (s > sfmax) sfmax = s;
+            }
+            if (sbmax - (double)(w->kernel.radius + w->dx) - sfmax > 0)
+                gap = sbmax - (double)(w->kernel.radius + w->dx) - sfmax;
+        }
         U = sqrt(2 * gmag * (smax - smin + gap + (double)w->dx));
         if (sqrt(v2max) > U) U = sqrt(v2max);
         c0 = 10 * U;
