@@ -1027,7 +1027,9 @@ typedef struct sph_world_def {
     sph_real gravity[3];       /* [m/s^2]; default (0, -9.81, 0) in 2D/3D (y is up), 0 in 1D;
                                   finite; components beyond dim are ignored                      */
     sph_solver solver;         /* used by sph_step / sph_advance (and sph_set_hydrostatic);
-                                  default SPH_SOLVER_WCSPH                                       */
+                                  default SPH_SOLVER_WCSPH. SPH_SOLVER_PCISPH with the other
+                                  fields as sph_world_def_default left them gets the original
+                                  PCISPH's settings, sph_world_def_pcisph(&def, 0)              */
     sph_density density;       /* default SPH_DENSITY_CONTINUITY; IISPH always uses summation    */
     sph_pressure_grad pressure_grad; /* default SPH_PGRAD_SYMMETRIC                               */
     sph_integrator integrator; /* default SPH_INTEGRATOR_SYMPLECTIC_EULER; read by WCSPH and
@@ -1556,7 +1558,9 @@ SPHDEF sph_status sph_step_wcsph(sph_world* w, sph_real dt);
    Adami walls with the Shepard wall density, Stormer-Verlet, per-particle factor and the multiphase
    pressure gradient). Each switch remains a def field to change afterwards. Both also set solver =
    SPH_SOLVER_PCISPH, tolerance = 1e-4, min_iterations = 3 and warm_start (0 original, 0.5
-   enhanced). def NULL is ignored. */
+   enhanced). def NULL is ignored. A def that sets only solver = SPH_SOLVER_PCISPH (every field
+   set here still at sph_world_def_default's value) is given the original's settings by
+   sph_world_init (sph__pcisph_unset). */
 SPHDEF void sph_world_def_pcisph(sph_world_def* def, int enhanced);
 /* One predictive-corrective step of dt [s]: pressures are corrected until the predicted density
    error is below def.tolerance on average (and def.tolerance_max at most, if set), after
@@ -3662,6 +3666,25 @@ static void sph__contact_ramp(sph_world* w) {
     w->priv.contact_short = (sph_real)fmin(sheet / full + 0.15, top / full + 0.04 - 0.15);
 }
 
+/* Whether def asks for PCISPH with none of the settings sph_world_def_pcisph makes: every one
+   of them still as sph_world_def_default left it (a host that only set def.solver). That mix,
+   WCSPH's continuity density with delta-SPH in a PCISPH solve with the prototype factor and a
+   0.1 % tolerance, is neither solver of the literature, and it
+   failed where both presets hold (2D dam break, a 0.4 x 0.8 m column in a 1.6 x 1 m tank, dx
+   0.02, sph_advance in 0.02 s frames: failed at 1.14 s; in SPH_FLOAT at 1.26 s after a frame that
+   gained 1.53 M g H of energy and returned SPH_OK).
+   sph_world_init then gives it the original solver's settings, sph_world_def_pcisph(def, 0)
+   (Solenthaler & Pajarola 2009), which ran those scenes clean. */
+static int sph__pcisph_unset(const sph_world_def* def) {
+    const sph_world_def d = sph_world_def_default(def->dim);
+    return def->solver == SPH_SOLVER_PCISPH && def->density == d.density &&
+           def->integrator == d.integrator && def->pcisph_factor == d.pcisph_factor &&
+           def->pressure_grad == d.pressure_grad && def->boundary_pressure == d.boundary_pressure &&
+           def->min_iterations == d.min_iterations && def->tolerance == d.tolerance &&
+           def->warm_start == d.warm_start && def->delta == d.delta &&
+           def->pressure_smoothing == d.pressure_smoothing;
+}
+
 SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
     sph_status s;
     sph_real hf, lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
@@ -3681,7 +3704,8 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
     w->dim = def->dim;
     w->dx = def->spacing;
     w->priv.solver = (int)def->solver; /* until a step says which solver runs */
-    if (def->boundary_pressure == SPH_BP_AUTO)
+    if (sph__pcisph_unset(def)) sph_world_def_pcisph(&w->def, 0);
+    if (w->def.boundary_pressure == SPH_BP_AUTO)
         w->def.boundary_pressure = def->solver == SPH_SOLVER_IISPH || def->solver == SPH_SOLVER_DFSPH ||
                                            def->solver == SPH_SOLVER_PBF
                                        ? SPH_BP_ZERO

@@ -433,7 +433,59 @@ static void test_pc_determinism(void) {
 #endif
 }
 
+/* A host that sets only def.solver = SPH_SOLVER_PCISPH gets the original solver's settings
+   (sph__pcisph_unset), and the dam break that mix of WCSPH's defaults failed runs through
+   sph_advance: a 0.4 x 0.8 m column in a 1.6 x 1 m tank, dx 0.02, started hydrostatic, 0.02 s
+   frames to 1.5 s. With WCSPH's defaults under PCISPH it failed at 1.14 s (in SPH_FLOAT at 1.26
+   s, after a frame that returned SPH_OK with the energy 1.53 M g H above its start). Asserted: the preset's settings in
+   w.def, every frame SPH_OK, no particle past the first wall layer, mass exact, the energy
+   (kinetic + potential) never above its start by more than 0.5 % of M g H. */
+static void test_pc_solver_alone(void) {
+    const double dx = 0.02, H = 0.8;
+    sph_world_def def = sph_world_def_default(2), orig = sph_world_def_default(2);
+    sph_world w;
+    sph_phase water;
+    sph_real lo[2] = {0, 0}, col[2] = {(sph_real)0.4, (sph_real)H}, tank[2] = {(sph_real)1.6, 1};
+    double e0 = 0, rise = 0, m0;
+    size_t i, out = 0;
+    int f;
+    memset(&water, 0, sizeof water);
+    water.rest_density = 1000;
+    def.solver = SPH_SOLVER_PCISPH;
+    def.spacing = (sph_real)dx;
+    sph_world_def_pcisph(&orig, 0);
+    CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
+    CHECK(w.def.density == orig.density && w.def.boundary_pressure == orig.boundary_pressure &&
+          w.def.tolerance == orig.tolerance && w.def.warm_start == orig.warm_start &&
+          w.def.min_iterations == orig.min_iterations && w.def.integrator == orig.integrator);
+    CHECK(sph_world_add_phase(&w, &water) == 0);
+    CHECK_EQ_INT(sph_fill_box(&w, 0, lo, col), SPH_OK);
+    CHECK_EQ_INT(sph_add_wall_box(&w, lo, tank, 0, 0), SPH_OK);
+    CHECK_EQ_INT(sph_set_hydrostatic(&w), SPH_OK);
+    m0 = sph_world_mass(&w);
+    for (i = 0; i < w.n; ++i) e0 += (double)w.mass * 9.81 * (double)w.x[2 * i + 1];
+    for (f = 0; f < 75; ++f) {
+        double e = 0;
+        const sph_status s = sph_advance(&w, (sph_real)0.02);
+        CHECK_MSG(s == SPH_OK, "t = %.2f s: %s", w.time, w.error);
+        if (s != SPH_OK) break;
+        for (i = 0; i < w.n; ++i) {
+            const double vx = (double)w.v[2 * i], vy = (double)w.v[2 * i + 1];
+            e += (double)w.mass * (9.81 * (double)w.x[2 * i + 1] + 0.5 * (vx * vx + vy * vy));
+            out += w.x[2 * i] < -0.5 * dx || w.x[2 * i] > 1.6 + 0.5 * dx || w.x[2 * i + 1] < -0.5 * dx;
+        }
+        if (e - e0 > rise) rise = e - e0;
+    }
+    CHECK_EQ_INT(out, 0);
+    CHECK_LE(fabs(sph_world_mass(&w) - m0) / m0, 1e-12);
+    CHECK_LE(rise / (m0 * 9.81 * H), 0.005);
+    TH_NOTE("PCISPH set alone: t = %.2f s, %llu steps, %d retries, energy rise %.2g M g H",
+            w.time, (unsigned long long)w.steps, w.stats.retries, rise / (m0 * 9.81 * H));
+    sph_world_free(&w);
+}
+
 const th_test tests_pcisph[] = {
+    {"pcisph/solver_alone_is_original", test_pc_solver_alone},
     {"pcisph/hydrostatic_tank", test_pc_hydrostatic},
     {"pcisph/two_layer_tank", test_pc_two_layer},
     {"pcisph/dam_break_vs_wcsph", test_pc_dam_break},
