@@ -140,7 +140,8 @@ int main(void) {
    asks for c0 = 10 max(sqrt(2 |g| H), |v|max), H the height the fluid can fall (its extent
    along gravity, plus the gap down to the walls below it), chosen at the first step, so density
    varies by about 1 %. Density by continuity (default) with delta-SPH diffusion (Molteni &
-   Colagrossi 2009, delta = 0.1), by summation, or by Ott & Schnetter's particle-density continuity for
+   Colagrossi 2009, delta = 0.1; without the hydrostatic part, Fourtakas et al. 2019, see
+   sph__delta_hydro), by summation, or by Ott & Schnetter's particle-density continuity for
    phases of very different density; negative pressures are clamped unless the domain is
    periodic in every direction (no tension at a free surface, def.clamp: see sph__clamps for
    why, and sph__rho_floor for the least carried density). Phases: with particle
@@ -1225,6 +1226,9 @@ typedef struct sph_stats {
     double v_max;             /* largest fluid speed [m/s]                                         */
     double a_max;             /* largest acceleration of the step [m/s^2]                          */
     double kinetic_energy;    /* sum 1/2 m |v|^2 [J]                                               */
+    double potential_energy;  /* -sum m g . x [J], the fluid's in gravity (0 without; periodic
+                                 directions left out): kinetic plus potential is the mechanical
+                                 energy, which nothing but the forcing raises                    */
     size_t pairs;             /* fluid-fluid neighbour pairs (each counted from both sides); with
                                  SPH_SCHEME_SECOND_ORDER those of its lists, which reach 0.2 dx
                                  beyond the support                                              */
@@ -1256,9 +1260,9 @@ typedef struct sph_stats {
                                  other solvers                                                  */
     double divergence_error;  /* DFSPH: mean max(D rho/Dt, 0) dt / rho0 after its divergence
                                  solve [-]; the other steps leave it unchanged                   */
-    double ke_low, ke_high;   /* PCISPH, IISPH, DFSPH without forcing: the least and the largest
-                                 kinetic energy since the forcing stopped [J] (the energy check,
-                                 sph__energy_check)                                              */
+    double ke_low, ke_high;   /* PCISPH, IISPH, DFSPH, PBF without forcing: the least mechanical
+                                 energy (kinetic + potential) and the largest kinetic energy since
+                                 the forcing stopped [J] (the energy check, sph__energy_check)   */
     long unforced_steps;      /* steps since then (0: forced, or none yet)                       */
     uint64_t neighbor_builds; /* neighbour searches (sort by cell and list build) since
                                  sph_world_init, in the steps kept (sph_advance undoes a
@@ -1325,6 +1329,10 @@ typedef struct sph__private {
                                        sum_b psi_ib v_b . grad W_ib over its wall neighbours, fixed
                                        within a step ((dim + 1) n; sph__wall_grad_sum)            */
     size_t wg_cap;
+    sph_real* abody;                /* WCSPH with delta-SPH and a body force: each fluid particle's
+                                       body acceleration of the step (gravity and def.force), for
+                                       sph__delta_hydro (dim n)                                   */
+    size_t abody_cap;
     sph_grid sgrid;                 /* second-order scheme: grid and lists at stage and shifted
                                        positions (the particles are not reordered mid-step)      */
     sph_neighbors snl;
@@ -3826,6 +3834,7 @@ SPHDEF void sph_world_free(sph_world* w) {
     SPH_FREE(w->priv.socw);
     SPH_FREE(w->priv.lapc);
     SPH_FREE(w->priv.wg);
+    SPH_FREE(w->priv.abody);
     SPH_FREE(w->priv.snap[0]);
     SPH_FREE(w->priv.snap[1]);
     sph_grid_free(&w->priv.sgrid);
@@ -4487,7 +4496,7 @@ SPHDEF size_t sph_world_memory(const sph_world* w) {
               w->priv.shift_cap +
               w->priv.xp_cap +
               w->priv.vp_cap + w->priv.de_cap + w->priv.cs_cap + w->priv.vn_cap + w->priv.bpq_cap + w->priv.soc_cap + w->priv.socw_cap +
-              w->priv.lapc_cap + w->priv.wg_cap) *
+              w->priv.lapc_cap + w->priv.wg_cap + w->priv.abody_cap) *
                  sizeof(sph_real);
     return bytes;
 }
@@ -4598,6 +4607,9 @@ typedef struct sph__ctx {
     const sph_real *ff_fw, *fb_fw; /* cached grad W factors per listed pair (SPH__CACHED passes)  */
     sph_real *ff_fw_out, *fb_fw_out; /* where SPH__STORE passes write them                        */
     sph_real delta_c;          /* if > 0, the speed in the delta-SPH term instead of each phase's c0 */
+    int delta_hs;              /* delta-SPH diffuses the density less its hydrostatic part (WCSPH
+                                  with gravity or a force callback; sph__delta_hydro)           */
+    const sph_real* abody;     /* delta_hs: the body accelerations of the step [m/s^2]          */
     const sph_real* pr2;       /* p / rho^2 per fluid particle (SPH__CACHED passes)              */
     const sph_real *pr2c, *volc; /* p / rho^2 and m / rho per fluid particle for fast-path passes
                                   (sph__pair_cache; NULL: computed per pair)                    */
@@ -4675,6 +4687,14 @@ static int sph__clamps(const sph_world* w) {
     return w->priv.solver == SPH_SOLVER_WCSPH && !all_periodic;
 }
 
+/* Whether delta-SPH leaves out the hydrostatic part (sph__delta_hydro): WCSPH with delta-SPH and
+   gravity or a force callback. */
+static int sph__delta_hydro_on(const sph_world* w) {
+    return w->def.delta > 0 && w->priv.solver == SPH_SOLVER_WCSPH &&
+           (w->def.gravity[0] != 0 || w->def.gravity[1] != 0 || w->def.gravity[2] != 0 ||
+            w->def.force != NULL);
+}
+
 static void sph__ctx_init(sph_world* w, sph__ctx* c) {
     int k, q;
     memset(c, 0, sizeof(*c));
@@ -4734,6 +4754,8 @@ static void sph__ctx_init(sph_world* w, sph__ctx* c) {
     c->av = w->def.alpha > 0 || w->def.beta > 0;
     c->delta = w->def.delta;
     c->delta_on = w->def.delta > 0;
+    c->delta_hs = sph__delta_hydro_on(w);
+    c->abody = NULL; /* set by sph__prepare_forces */
     /* Monaghan 2005 / Enhanced PCISPH 2018 sec. 2.2.2: nu Lap v = 2(d+2) sum_j m_j
        nu_bar/rho_bar ...; with (mu_i + mu_j)/(rho_i rho_j) the factor 2 of the average moves into
        visc_k = d + 2. */
@@ -5068,6 +5090,7 @@ static sph_status sph__scratch(sph_world* w, sph_real** p, size_t count) {
                   : p == &w->priv.socw  ? &w->priv.socw_cap
                   : p == &w->priv.lapc  ? &w->priv.lapc_cap
                   : p == &w->priv.wg    ? &w->priv.wg_cap
+                  : p == &w->priv.abody ? &w->priv.abody_cap
                                         : NULL;
     SPH_ASSERT(cap);
     if (count <= *cap && *p) return SPH_OK;
@@ -5918,13 +5941,40 @@ SPH__INLINE sph_real sph__wall_pterm(const sph__ctx* c, int pgrad, sph_real mi, 
    phase at its own rest density (rho/rho0 = 1 on both sides at rest) and has no equation of
    state, and the compressible step's per-particle sound speeds (gases) are not one phase's
    modulus (its 1000:1 interface at rest, tests/test_compressible.c, kept the air 20 % calmer
-   with the plain difference): both keep it. */
+   with the plain difference): both keep it. dph is the hydrostatic part of p_i - p_j, left out
+   as within a phase (sph__delta_hydro): (rho_i + rho_j)/2 g . x_ij. */
 SPH__INLINE sph_real sph__delta_across(const sph__ctx* c, const sph__phase_c* P,
                                        const sph__phase_c* Pj, sph_real rhati, sph_real rhatj,
-                                       sph_real pi, sph_real pj) {
+                                       sph_real pi, sph_real pj, sph_real dph) {
     const sph_real Ki = P->rho0 * P->c0 * P->c0, Kj = Pj->rho0 * Pj->c0 * Pj->c0;
     if (!c->eos_walls || c->cs || !(Ki > 0) || !(Kj > 0)) return rhati - rhatj;
-    return (pi - pj) / (Ki > Kj ? Ki : Kj);
+    return (pi - pj - dph) / (Ki > Kj ? Ki : Kj);
+}
+
+/* delta-SPH's hydrostatic part (Fourtakas, Dominguez, Vacondio & Rogers 2019, the density
+   diffusion term with the hydrostatic density subtracted; DualSPHysics' default): in a fluid at
+   rest under gravity WCSPH's equation of state makes rho/rho0 grow with depth, by
+   (rho_i/rho0) g . x_ij / c_i^2 between two particles to first order (grad p = rho g, d p =
+   c^2 d rho, c_i the local sound speed of particle i's state; gh = (rho_i/rho0) g / c_i^2; with
+   c0 in place of c_i a film resting at rho/rho0 = 1.003 sank 0.06 dx in 4 s). g is particle i's
+   body acceleration of the step (gravity plus def.force, as the walls' extrapolation reads it),
+   so a force field that replaces gravity gives the same step.
+   Molteni & Colagrossi's term diffuses that gradient too. Inside the fluid a linear profile
+   diffuses to nothing, but where the kernel is cut (a free surface) or the other side is a wall
+   whose extrapolated density carries the same gradient (Adami et al. 2012), the sum does not
+   vanish and the carried density climbs: the surface rows and, worst, a film on a floor, whose
+   every particle sees only the wall below. Measured on a film one particle thick on the floor of
+   a 1 x 0.3 m tank (dx 0.02, WCSPH, sph_advance in 0.05 s frames): its density rose from 1002 to
+   1006 kg/m^3 within 1 s, lifting it 0.3 dx and its energy by 1.5 J per metre (0.38 rho g H^2
+   with H = dx) with every frame SPH_OK, climbing on (0.9 rho g H^2 at 4 s); delta = 0 kept it at
+   rest. So the pair diffuses rho_i/rho0 - rho_j/rho0 - g . x_ij / c0^2 (a wall the same with its
+   extrapolated density; zero and mirrored walls copy the particle's own density and get no
+   hydrostatic part), which is zero everywhere in a fluid at rest. Phases of one pair only: a
+   pair across an interface diffuses its pressure difference (sph__delta_across). */
+SPH__INLINE sph_real sph__delta_hydro(const sph_real* gh, const sph_real* d, int D) {
+    return D == 3 ? gh[0] * d[0] + gh[1] * d[1] + gh[2] * d[2]
+           : D == 2 ? gh[0] * d[0] + gh[1] * d[1]
+                    : gh[0] * d[0];
 }
 
 /* sph__accel_row's last loop: ai[k] += lm_m dv[k][m] (if lm) + fs_m dd[k][m] over the row, in
@@ -6090,10 +6140,17 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
     const sph_real rhati = rhoi * P->inv_rho0;
     const sph_real dcoef = c->delta * c->h * (c->delta_c > 0 ? c->delta_c : P->c0) * 2 * P->rho0;
     const sph_real ci = cs ? cs[i] : P->c0;
+    sph_real gh[3] = {0, 0, 0}; /* (rho_i/rho0) g / c_i^2 [1/m]: sph__delta_hydro */
+    sph_real ga[3] = {0, 0, 0}; /* g, i's body acceleration [m/s^2] (the same)        */
     const int os = c->density == SPH_DENSITY_PARTICLE;
     sph_real ai[3] = {0, 0, 0}, R = 0, E = 0;
     size_t kk, k0 = c->ff->begin[i], k1 = k0 + c->ff->count[i];
     int k;
+    if (c->abody && (flags & SPH__RATE) && !P->gas) {
+        const sph_real c2 = P->gamma * (pi + P->ck) * inv_rhoi; /* the local sound speed^2 */
+        SPH__FOR_K(D, ga[k] = c->abody[i * (size_t)D + (size_t)k]);
+        if (c2 > 0) SPH__FOR_K(D, gh[k] = rhati * ga[k] / c2);
+    }
     /* the packed row: viscous passes (cached or not) and passes that evaluate the kernel
        (PCISPH's pressure passes at predicted positions); a cached pressure-only pass has no
        square root or division for it to pack */
@@ -6122,8 +6179,10 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
             R += (os ? mi : mj) * fw * vd;
             if (c->delta_on)
                 R += dcoef * ((fast && c->volc) ? c->volc[j] : mj / rhoj) *
-                     (Pj == P ? rhati - rhoj * Pj->inv_rho0
-                              : sph__delta_across(c, P, Pj, rhati, rhoj * Pj->inv_rho0, pi, c->p[j])) *
+                     (Pj == P ? rhati - rhoj * Pj->inv_rho0 - sph__delta_hydro(gh, d, D)
+                              : sph__delta_across(c, P, Pj, rhati, rhoj * Pj->inv_rho0, pi, c->p[j],
+                                                  SPH__R(0.5) * (rhoi + rhoj) *
+                                                      sph__delta_hydro(ga, d, D))) *
                      fw * r2 / (r2 + c->eta2);
         }
         if (flags & SPH__PRESSURE) {
@@ -6204,7 +6263,10 @@ SPH__INLINE void sph__interact_one(const sph__ctx* c, size_t i, const int D, con
             if (flags & SPH__STORE) c->fb_fw_out[kk] = fw;
             if (flags & SPH__RATE) {
                 R += psi * fw * vd; /* the wall's own velocity: a moving wall compresses */
-                if (c->delta_on) R += dcoef * Vb * (rhati - kap) * fw * r2 / (r2 + c->eta2);
+                if (c->delta_on)
+                    R += dcoef * Vb *
+                         (rhati - kap - (bq || c->bp_mode == SPH_BP_EXTRAPOLATE ? sph__delta_hydro(gh, d, D) : 0)) *
+                         fw * r2 / (r2 + c->eta2);
             }
             if (flags & SPH__PRESSURE) {
                 const sph_real pb = bq ? bq[0] : c->bp_mode == SPH_BP_EXTRAPOLATE ? c->bp[b]
@@ -6384,13 +6446,15 @@ static sph_status sph__check_step_input(sph_world* w, sph_real dt) {
          WCSPH step at 100k, which a second thread could not share); only a bad world is
          searched again, serially, for its first bad particle and the message */
         int bad = 0;
-        double ke = 0; /* the kinetic energy the step starts from, for the energy check */
+        /* the kinetic and potential energy the step starts from, for the energy check (pa: the
+           size of the potential's terms, for the rounding of its sum) */
+        double ke = 0, pe = 0, pa = 0;
         sph__idx j;
 #if defined(_OPENMP)
-#pragma omp parallel for schedule(static) reduction(| : bad) reduction(+ : ke) if (w->n > 2048)
+#pragma omp parallel for schedule(static) reduction(| : bad) reduction(+ : ke, pe, pa) if (w->n > 2048)
 #endif
         for (j = 0; j < (sph__idx)w->n; ++j) {
-            double v2 = 0;
+            double v2 = 0, gx = 0;
             int kk, b = !sph__finite((double)w->rho[j]) || !(w->rho[j] > 0) ||
                         (w->e && !sph__finite((double)w->e[j]));
             for (kk = 0; kk < (int)D; ++kk) {
@@ -6398,16 +6462,21 @@ static sph_status sph__check_step_input(sph_world* w, sph_real dt) {
                 b |= !sph__finite((double)w->x[(size_t)j * D + (size_t)kk]) || !sph__finite(vk) ||
                      fabs((double)w->x[(size_t)j * D + (size_t)kk]) > far;
                 v2 += vk * vk;
+                if (!w->def.periodic[kk])
+                    gx += (double)w->def.gravity[kk] * (double)w->x[(size_t)j * D + (size_t)kk];
             }
             ke += 0.5 * (double)(w->m ? w->m[j] : w->mass) * v2;
+            pe -= (double)(w->m ? w->m[j] : w->mass) * gx;
+            pa += (double)(w->m ? w->m[j] : w->mass) * fabs(gx);
             bad |= b;
         }
         if (!bad) i = w->n; /* skip the serial search below */
         else i = 0;
-        /* the host changed the velocities (or added moving particles) since the last step: the
-           energy check starts again from here (a rounding-level difference is the order of the
-           sums) */
-        if (!bad && !(fabs(ke - w->stats.kinetic_energy) <= 1e-9 * (ke + w->stats.kinetic_energy)))
+        /* the host changed the velocities or positions (or added particles) since the last
+           step: the energy check starts again from here (a rounding-level difference is the
+           order of the sums) */
+        if (!bad && (!(fabs(ke - w->stats.kinetic_energy) <= 1e-9 * (ke + w->stats.kinetic_energy)) ||
+                     !(fabs(pe - w->stats.potential_energy) <= 1e-9 * pa)))
             w->stats.unforced_steps = 0;
     }
     for (; i < w->n; ++i) {
@@ -6478,8 +6547,8 @@ static sph_status sph__boundary_motion(sph_world* w, double t) {
    `final`, also the step's diagnostics and blow-up detection. Reductions run over fixed blocks
    combined in block order, so the result does not depend on the number of threads. */
 enum { SPH__RED_KE, SPH__RED_ERRSUM, SPH__RED_ERRMAX, SPH__RED_COMP, SPH__RED_V2MAX,
-       SPH__RED_A2MAX, SPH__RED_OUT, SPH__RED_CONTACT, SPH__RED_WREL, SPH__RED_BAD, SPH__RED_KIND,
-       SPH__RED_N };
+       SPH__RED_A2MAX, SPH__RED_OUT, SPH__RED_CONTACT, SPH__RED_WREL, SPH__RED_PE, SPH__RED_BAD,
+       SPH__RED_KIND, SPH__RED_N };
 enum { SPH__BAD_NONE, SPH__BAD_NONFINITE, SPH__BAD_DENSITY, SPH__BAD_COMPRESSION, SPH__BAD_SPEED,
        SPH__BAD_ENERGY, SPH__BAD_DISPLACEMENT, SPH__BAD_WALL, SPH__BAD_TANK };
 
@@ -6740,44 +6809,64 @@ static int sph__wall_contact(const sph__ctx* c, size_t i, const sph__contact_arg
     return moved;
 }
 
-/* The energy check of the incompressible solvers (PCISPH, IISPH, DFSPH). Without gravity, force
-   callback or moving walls nothing does work on their fluid but its pressure, which gives back no
-   more than the compression it stores, and viscosity, which only takes; at their compression
-   (0.1 %) the stored energy is tiny and only motion makes more of it. So once the forcing stops,
-   a kinetic energy that climbs above the least it has had since by more than half the largest
-   (or, for a fluid started compressed, by more than twice the energy that compression stored at
-   the first unforced step, sum_i p_i V_i max(rho_i/rho0 - 1, 0); and a floor of 1e-4 spacings
-   per step in speed) is the walls or the solver doing work: the step fails with
-   SPH_ERR_UNSTABLE. Measured: the original PCISPH with extrapolated wall pressure in a closed
-   vortex box at a hand-set dt of 2 ms climbed from 5 J to 490 J within 0.4 s below the speed
-   bound (tests/test_reliability.c's kinetic_energy_decays, which now runs at the library's own
-   steps, where it decays); the decaying flows of the tests rise by at most
-   6 % of their start between samples. WCSPH stores real elastic energy (a droplet may rebound)
-   and the compressible step's gas trades internal energy for motion: both are exempt. A host that
-   changes velocities between steps (a game's splash) starts the check again
-   (sph__check_step_input). */
-static sph_status sph__energy_check(sph_world* w, double ke, double wrel) {
+/* The energy check of the incompressible solvers (PCISPH, IISPH, DFSPH; PBF without gravity).
+   Without a force callback or moving walls nothing does work on their fluid but gravity, which
+   only trades potential for kinetic energy, its pressure, which gives back no more than the
+   compression it stores, and viscosity, which only takes; at their compression (0.1 %) the stored
+   energy is tiny and only motion makes more of it. So once the forcing stops, a mechanical energy
+   E = kinetic + potential (-sum m g . x) that climbs above the least it has had since by more than
+   half the largest kinetic energy (or by more than twice the largest energy compression stored
+   since, sum_i p_i V_i max(rho_i/rho0 - 1, 0); and a floor of 1e-4 c0 in speed (it was 1e-4
+   spacings per step, which a retried step shrinking dt by a thousand made a thousand times larger,
+   until a real gain passed) and, with gravity, of a tenth of a spacing's lift of the whole mass,
+   0.1 M |g| dx) is the walls or the solver doing work: the step fails with SPH_ERR_UNSTABLE.
+   Gravity along a periodic direction drives the flow (a channel): forcing. Measured without
+   gravity: the original PCISPH with extrapolated wall pressure in a closed vortex box at a hand-
+   set dt of 2 ms climbed from 5 J to 490 J within 0.4 s below the speed bound
+   (tests/test_reliability.c's kinetic_energy_decays, which now runs at the library's own steps,
+   where it decays); the decaying flows of the tests rise by at most 6 % of their start between
+   samples. With gravity (where the check used to be off): a single particle bouncing on the floor
+   of a box under enhanced PCISPH climbed to 298 m g dx above its start by 1.1 s, every frame
+   SPH_OK, until its speed passed the bound. The floor covers what the wall contact
+   (sph__wall_contact) lifts when it moves particles out of a wall, and the potential energy a
+   settling column gives back. WCSPH stores real elastic energy (a droplet may rebound) and the
+   compressible step's gas trades internal energy for motion: both are exempt, and so is PBF under
+   gravity: its projection keeps a column compressed by up to its 1 % target in the positions, not
+   in a pressure, and gives it back as lift (its 2D tank at rest, 40 layers, rose more than the
+   floor and failed at 0.1 s). A host that changes velocities or positions between steps (a game's
+   splash, an emitter) starts the check again (sph__check_step_input). */
+static sph_status sph__energy_check(sph_world* w, double ke, double pe, double wrel) {
     sph_stats* st = &w->stats;
     int k, forced = w->def.force != NULL || w->def.boundary_motion != NULL ||
                     !sph__incompressible(w->priv.solver);
-    for (k = 0; k < w->dim; ++k) forced |= w->def.gravity[k] != 0;
+    const double e = ke + pe;
+    for (k = 0; k < w->dim; ++k) /* PBF: see above; gravity along a periodic direction drives */
+        forced |= w->def.gravity[k] != 0 && (w->def.periodic[k] || w->priv.solver == SPH_SOLVER_PBF);
     if (forced || !(st->dt > 0)) {
         st->unforced_steps = 0;
         return SPH_OK;
     }
     if (st->unforced_steps > 0) {
-        const double floor_v = 1e-4 * (double)w->dx / st->dt;
-        if (ke - st->ke_low > 0.5 * st->ke_high + 0.5 * sph_world_mass(w) * floor_v * floor_v)
+        const double M = sph_world_mass(w);
+        double g2 = 0, floor_v = 0;
+        for (k = 0; k < w->nphase; ++k)
+            if (1e-4 * (double)w->phases[k].sound_speed > floor_v)
+                floor_v = 1e-4 * (double)w->phases[k].sound_speed;
+        for (k = 0; k < w->dim; ++k) g2 += (double)w->def.gravity[k] * (double)w->def.gravity[k];
+        if (e - st->ke_low >
+            0.5 * st->ke_high + 0.5 * M * floor_v * floor_v + 0.1 * M * sqrt(g2) * (double)w->dx)
             return sph__fail(w, SPH_ERR_UNSTABLE, -1,
-                             "step %llu (t = %g s): the kinetic energy rose to %g J without "
-                             "forcing (no gravity, force callback or moving wall), from %g J at "
-                             "least and %g J at most since the forcing stopped: the walls or the "
-                             "solver did work on the fluid",
-                             (unsigned long long)w->steps, w->time, ke, st->ke_low, st->ke_high);
-        if (ke < st->ke_low) st->ke_low = ke;
+                             "step %llu (t = %g s): the mechanical energy (kinetic + potential) "
+                             "rose %g J above the least it had since the forcing stopped (%g J; "
+                             "kinetic now %g J, at most %g J) without forcing (no force callback "
+                             "or moving wall): the walls or the solver did work on the fluid",
+                             (unsigned long long)w->steps, w->time, e - st->ke_low, st->ke_low, ke,
+                             st->ke_high);
+        if (e < st->ke_low) st->ke_low = e;
         if (ke > st->ke_high) st->ke_high = ke;
+        if (4 * wrel > st->ke_high) st->ke_high = 4 * wrel;
     } else {
-        st->ke_low = ke;
+        st->ke_low = e;
         st->ke_high = ke > 4 * wrel ? ke : 4 * wrel;
     }
     ++st->unforced_steps;
@@ -7044,6 +7133,8 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 bad = SPH__BAD_WALL;
             else if (tank && sph__tank_outside(w, xi)) bad = SPH__BAD_TANK;
             r[SPH__RED_KE] += 0.5 * mi * v2;
+            for (kk = 0; kk < D; ++kk)
+                if (!c->per[kk]) r[SPH__RED_PE] -= mi * (double)c->g[kk] * (double)xi[kk];
             if (err > 0 && w->p && w->rho[i] > 0)
                 r[SPH__RED_WREL] += (double)w->p[i] * mi / (double)w->rho[i] * err;
             r[SPH__RED_ERRSUM] += fabs(err);
@@ -7073,6 +7164,7 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
         red[SPH__RED_OUT] += r[SPH__RED_OUT];
         red[SPH__RED_CONTACT] += r[SPH__RED_CONTACT];
         red[SPH__RED_WREL] += r[SPH__RED_WREL];
+        red[SPH__RED_PE] += r[SPH__RED_PE];
         if (red[SPH__RED_BAD] < 0 && r[SPH__RED_BAD] >= 0) {
             red[SPH__RED_BAD] = r[SPH__RED_BAD];
             red[SPH__RED_KIND] = r[SPH__RED_KIND];
@@ -7092,6 +7184,7 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 }
     }
     w->stats.kinetic_energy = red[SPH__RED_KE];
+    w->stats.potential_energy = red[SPH__RED_PE];
     w->stats.density_error_avg = w->n ? red[SPH__RED_ERRSUM] / (double)w->n : 0;
     w->stats.density_error_max = red[SPH__RED_ERRMAX];
     w->stats.compression_avg = w->n ? red[SPH__RED_COMP] / (double)w->n : 0;
@@ -7100,7 +7193,8 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
     w->stats.n_outside = (size_t)red[SPH__RED_OUT];
     w->stats.contacts = (size_t)red[SPH__RED_CONTACT];
     if (red[SPH__RED_BAD] < 0) {
-        const sph_status s = sph__energy_check(w, red[SPH__RED_KE], red[SPH__RED_WREL]);
+        const sph_status s =
+            sph__energy_check(w, red[SPH__RED_KE], red[SPH__RED_PE], red[SPH__RED_WREL]);
         if (s != SPH_OK) return s;
     }
     if (red[SPH__RED_BAD] >= 0) {
@@ -7445,6 +7539,20 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
 
 /* Boundary motion at time t, neighbour search, summation density if chosen, equation of state,
    wall extrapolation: the state every force evaluation starts from. */
+/* delta-SPH's hydrostatic part (sph__delta_hydro) reads each particle's body acceleration: a copy
+   of w->a right after sph__stage_body_force, before the passes add to it, into scratch reserved
+   when the step begins (sph__body_accel_reserve: a step that runs out of memory changes nothing). */
+static sph_status sph__body_accel_reserve(sph_world* w) {
+    if (!sph__delta_hydro_on(w)) return SPH_OK;
+    return sph__scratch(w, &w->priv.abody, w->capacity * (size_t)w->dim);
+}
+
+static void sph__keep_body_accel(sph_world* w, sph__ctx* c) {
+    if (!c->delta_hs || w->priv.abody_cap < w->n * (size_t)w->dim) return;
+    sph__copy(w->priv.abody, w->a, w->n * (size_t)w->dim * sizeof(sph_real));
+    c->abody = w->priv.abody;
+}
+
 static sph_status sph__prepare_forces(sph_world* w, sph__ctx* c, double t, double* t0) {
     sph_status s = sph__boundary_motion(w, t);
     if (s != SPH_OK) return s;
@@ -7460,6 +7568,7 @@ static sph_status sph__prepare_forces(sph_world* w, sph__ctx* c, double t, doubl
     sph__stage_eos(w, c);
     sph__time(w, SPH_STAGE_PRESSURE, t0);
     if ((s = sph__stage_body_force(w, c)) != SPH_OK) return s;
+    sph__keep_body_accel(w, c);
     sph__time(w, SPH_STAGE_FORCES, t0);
     if (w->nb > 0) sph__stage_wall(w, c, SPH__WALL_STATE | SPH__WALL_PRESSURE);
     sph__time(w, SPH_STAGE_PRESSURE, t0);
@@ -7625,6 +7734,7 @@ static sph_status sph__step_wcsph_euler(sph_world* w, sph_real dt) {
     sph__ctx c;
     sph_status s = sph__pair_cache_reserve(w);
     if (s == SPH_OK) s = sph__shift_reserve(w);
+    if (s == SPH_OK) s = sph__body_accel_reserve(w);
     if (s == SPH_OK) s = sph__prepare_forces(w, &c, w->time, &t0);
     if (s == SPH_OK && cont) s = sph__rate_cache(w, &c);
     if (s != SPH_OK) return s;
@@ -7659,6 +7769,7 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
         if (s != SPH_OK) return s;
     }
     if ((s = sph__shift_reserve(w)) != SPH_OK) return s;
+    if ((s = sph__body_accel_reserve(w)) != SPH_OK) return s;
     /* x^n, to undo the drift if the neighbour search runs out of memory (sph__undo_drift) */
     s = sph__scratch(w, &w->priv.xp, w->capacity * (size_t)w->dim);
     if (s != SPH_OK) return s;
@@ -7692,6 +7803,7 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
     sph__stage_eos(w, &c);
     sph__time(w, SPH_STAGE_PRESSURE, &t0);
     if ((s = sph__stage_body_force(w, &c)) != SPH_OK) return s;
+    sph__keep_body_accel(w, &c);
     sph__time(w, SPH_STAGE_FORCES, &t0);
     if (w->nb > 0) sph__stage_wall(w, &c, SPH__WALL_STATE | SPH__WALL_PRESSURE);
     sph__time(w, SPH_STAGE_PRESSURE, &t0);
@@ -10605,7 +10717,7 @@ typedef struct sph__sink {
     int err;
 } sph__sink;
 
-#define SPH__SAVE_VERSION 1u
+#define SPH__SAVE_VERSION 2u /* 2: sph_stats.potential_energy */
 #define SPH__FNV_OFFSET 14695981039346656037ull
 #define SPH__FNV_PRIME 1099511628211ull
 
@@ -10837,7 +10949,7 @@ static sph_status sph__check_loaded_finite(sph_world* w, const char* name, const
    reads them). */
 static sph_status sph__check_loaded(sph_world* w) {
     const size_t D = (size_t)w->dim, n = w->n, nb = w->nb;
-    const double* st[9];
+    const double* st[10];
     size_t i;
     sph_status s;
     int k;
@@ -10854,11 +10966,11 @@ static sph_status sph__check_loaded(sph_world* w) {
     st[0] = &w->stats.dt; st[1] = &w->stats.solver_error; st[2] = &w->stats.density_error_avg;
     st[3] = &w->stats.density_error_max; st[4] = &w->stats.compression_avg;
     st[5] = &w->stats.v_max; st[6] = &w->stats.a_max; st[7] = &w->stats.kinetic_energy;
-    st[8] = &w->stats.step_time;
-    for (k = 0; k < 9; ++k)
-        if (!sph__finite(*st[k]) || (k >= 5 && *st[k] < 0))
+    st[8] = &w->stats.step_time; st[9] = &w->stats.potential_energy;
+    for (k = 0; k < 10; ++k)
+        if (!sph__finite(*st[k]) || (k >= 5 && k < 9 && *st[k] < 0))
             return sph__fail(w, SPH_ERR_ARG, -1, "sph_world_load: stats field %d = %g: must be "
-                             "finite%s", k, *st[k], k >= 5 ? " and >= 0" : "");
+                             "finite%s", k, *st[k], k >= 5 && k < 9 ? " and >= 0" : "");
     if (n > 0 && !w->priv.have_mass)
         return sph__fail(w, SPH_ERR_ARG, -1, "sph_world_load: %zu fluid particles but no mass", n);
     if (w->priv.have_mass && (!sph__finite((double)w->mass) || !(w->mass > 0)))
