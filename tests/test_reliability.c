@@ -729,9 +729,9 @@ static void test_pcisph_orig_box_frames(void) {
     }
 }
 
-/* The energy check with gravity (sph__energy_check): a 2D tank at rest (0.4 m box, water 0.3 m
-   deep, dx 0.02, sph_set_hydrostatic), PCISPH (both), IISPH and DFSPH through sph_advance in
-   0.02 s frames for 1 s: every frame returns SPH_OK (no false alarm while the tank settles, the
+/* The energy check with gravity (sph__energy_check): a tank at rest (0.4 m box, water 0.3 m
+   deep, sph_set_hydrostatic; 2D at dx 0.02 with PCISPH (both), IISPH and DFSPH, 3D at dx 0.04
+   with IISPH and DFSPH) through sph_advance in 0.02 s frames for 1 s: every frame returns SPH_OK (no false alarm while the tank settles, the
    wall contact lifting particles and the column giving back its start). Then the check's own
    record of the least mechanical energy since the forcing stopped (w.stats.ke_low, saved with
    the world) is lowered by M g dx, as if the water had risen a spacing since without
@@ -740,20 +740,23 @@ static void test_pcisph_orig_box_frames(void) {
    single particle bouncing in a box under enhanced PCISPH climbed to 298 m g dx above its start
    with every frame SPH_OK.) */
 static void test_energy_check_gravity(void) {
-    static const int which[4][2] = {{SPH_SOLVER_PCISPH, 0}, {SPH_SOLVER_PCISPH, 1},
-                                    {SPH_SOLVER_IISPH, -1}, {SPH_SOLVER_DFSPH, -1}};
+    static const int which[6][3] = {{2, SPH_SOLVER_PCISPH, 0}, {2, SPH_SOLVER_PCISPH, 1},
+                                    {2, SPH_SOLVER_IISPH, -1}, {2, SPH_SOLVER_DFSPH, -1},
+                                    {3, SPH_SOLVER_IISPH, -1}, {3, SPH_SOLVER_DFSPH, -1}};
     int q;
-    for (q = 0; q < 4; ++q) {
-        sph_world_def def = sph_world_def_default(2);
+    for (q = 0; q < 6; ++q) {
+        const int dim = which[q][0];
+        const double dx = dim == 2 ? 0.02 : 0.04;
+        sph_world_def def = sph_world_def_default(dim);
         sph_world w;
         sph_phase water;
-        sph_real lo[2] = {0, 0}, hi[2] = {0.4, 0.4}, fh[2] = {0.4, 0.3};
+        sph_real lo[3] = {0, 0, 0}, hi[3] = {0.4, 0.4, 0.4}, fh[3] = {0.4, 0.3, 0.4};
         sph_status s = SPH_OK;
         double t_ok, M;
         int frame;
-        if (which[q][1] >= 0) sph_world_def_pcisph(&def, which[q][1]);
-        def.solver = (sph_solver)which[q][0];
-        def.spacing = (sph_real)0.02;
+        if (which[q][2] >= 0) sph_world_def_pcisph(&def, which[q][2]);
+        def.solver = (sph_solver)which[q][1];
+        def.spacing = (sph_real)dx;
         memset(&water, 0, sizeof water);
         water.rest_density = 1000;
         CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
@@ -764,11 +767,11 @@ static void test_energy_check_gravity(void) {
         for (frame = 1; frame <= 50 && s == SPH_OK; ++frame) s = sph_advance(&w, (sph_real)0.02);
         CHECK_MSG(s == SPH_OK, "%s: %s", solver_name(&def), w.error);
         M = sph_world_mass(&w);
-        w.stats.ke_low -= M * 9.81 * 0.02;
+        w.stats.ke_low -= M * 9.81 * dx;
         t_ok = w.time;
         s = sph_advance(&w, (sph_real)0.02);
-        TH_NOTE("%-11s tank at rest 1 s: ok; with the least energy lowered by M g dx: %s",
-                solver_name(&def), s == SPH_OK ? "ok" : w.error);
+        TH_NOTE("%-11s %dD tank at rest 1 s: ok; with the least energy lowered by M g dx: %s",
+                solver_name(&def), dim, s == SPH_OK ? "ok" : w.error);
         CHECK_EQ_INT(s, SPH_ERR_UNSTABLE);
         CHECK_MSG(strstr(w.error, "mechanical energy") != NULL, "%s: %s", solver_name(&def),
                   w.error);

@@ -501,9 +501,6 @@ static void sc_schemes(sc_scene sc, int dim, double dx, double duration, sc_expe
         }
 }
 
-/* A fluid filling a closed box, without gravity, stirred by a vortex (nu = 0.01 m^2/s): every
-   solver with every wall scheme holds (PCISPH, IISPH and DFSPH solve it with zero wall
-   pressure, see sph__enclosed). */
 /* A film one spacing thick on the floor (2D: 1 m long, dx 0.02, 2 s; 3D: 0.4 m square, dx 0.04,
    1 s), every solver: the run gets through, nothing leaves, and the energy is never above its
    start by more than 0.5 % of rho g H^2 W with H = dx. WCSPH's delta-SPH diffused the hydrostatic
@@ -518,6 +515,9 @@ static void sc_schemes(sc_scene sc, int dim, double dx, double duration, sc_expe
 static void test_film_2d(void) { sc_defaults(SC_FILM, 2, 0.02, 2.0); }
 static void test_film_3d(void) { sc_defaults(SC_FILM, 3, 0.04, 1.0); }
 
+/* A fluid filling a closed box, without gravity, stirred by a vortex (nu = 0.01 m^2/s): every
+   solver with every wall scheme holds (PCISPH, IISPH and DFSPH solve it with zero wall
+   pressure, see sph__enclosed). */
 static void test_box_schemes_2d(void) { sc_schemes(SC_BOX, 2, 0.04, 0.5, SC_HOLDS); }
 static void test_box_schemes_3d(void) { sc_schemes(SC_BOX, 3, 0.05, 0.3, SC_HOLDS); }
 
