@@ -410,13 +410,15 @@ int main(void) {
    ERRORS
    Functions that can fail return sph_status; w.error holds a message with the detail (field,
    particle index and id, value) and w.error_index the particle. Bad input (an invalid def field
-   or phase, non-finite positions or velocities, dt <= 0, a bad phase index) is rejected before
-   anything changes. A blow-up (a non-finite value, density <= 0, compression beyond
+   or phase, non-finite positions or velocities, dt <= 0, a bad phase index, fluid added within
+   1e-3 spacings of fluid already there or of itself: the same box filled twice) is rejected
+   before anything changes. A blow-up (a non-finite value, density <= 0, compression beyond
    def.max_compression, a speed beyond def.max_speed's bound, a particle moving more than
    def.max_displacement spacings in one step or ending inside a wall's layers, def.check_walls;
-   for PCISPH, IISPH and DFSPH without gravity, force callback or moving walls, a kinetic energy
-   that climbs above the least it has had by more than half the largest: walls or solver doing
-   work) is reported as SPH_ERR_UNSTABLE at the step where it happens, naming the first offending
+   for PCISPH, IISPH, DFSPH and PBF without force callback or moving walls, a mechanical energy
+   (kinetic + gravity's potential) that climbs above the least it has had by more than half the
+   largest kinetic energy: walls or solver doing work; PBF under gravity, and gravity along a
+   periodic direction, count as forcing) is reported as SPH_ERR_UNSTABLE at the step where it happens, naming the first offending
    particle; an iterative pressure solve that stops at max_iterations above its tolerance returns
    SPH_ERR_NOT_CONVERGED (the step was taken). sph_advance turns both into retries: the failed
    sub-step is undone bit for bit and taken again at half the step (up to 12 times in a row, the
@@ -1130,7 +1132,9 @@ typedef struct sph_world_def {
     int periodic[3];           /* nonzero: direction wraps over [domain_lo, domain_hi), which must
                                   be at least two kernel support radii long; default 0          */
     sph_real max_compression;  /* blow-up if rho/rho0 - 1 exceeds it [-]; default 0.2; 0 = no
-                                  check; >= 0; not applied to gas phases                         */
+                                  check; >= 0; not applied to gas phases. IISPH and DFSPH: the
+                                  density their solve predicts for the step's end (a host's
+                                  particles placed into others they push apart)               */
     sph_real max_speed;        /* blow-up if |v| exceeds it [m/s]; 0 (default) = the largest c0
                                   (WCSPH), 10 c0 (compressible step), c0 + 2 |v_wall|max for
                                   PCISPH, IISPH, DFSPH and PBF (ten times the free-fall speed
@@ -1466,11 +1470,16 @@ SPHDEF int sph_world_add_phase(sph_world* w, const sph_phase* phase);
    in w->fill_spacing afterwards (an extent of 1.03 dx gets one particle at spacing 1.03 dx and
    3 % more mass than w->phases[phase].mass; make extents whole multiples of dx to keep dx).
    Particles sit at the cell centres, half a spacing in from the faces, at rest. SPH_ERR_ARG for a bad phase, lo or hi NULL, not
-   finite or hi <= lo, or an extent below half a spacing; SPH_ERR_CAPACITY for a huge box. */
+   finite or hi <= lo, an extent below half a spacing, or a particle within 1e-3 spacings of
+   fluid already there (the same box filled twice: coincident particles never separate);
+   SPH_ERR_CAPACITY for a huge box. */
 SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, const sph_real* hi);
 /* Adds n fluid particles at x[i*dim + k] with velocities v (NULL = at rest), density rho0, the
-   phase's mass and its back pressure. SPH_ERR_ARG (nothing added) for a bad phase, x NULL or a
-   non-finite x or v; n = 0 does nothing. */
+   phase's mass and its back pressure. SPH_ERR_ARG (nothing added) for a bad phase, x NULL, a
+   non-finite x or v, or a particle within 1e-3 spacings of another of x or of fluid already in
+   the world (coincident particles never separate; closer than a spacing but not coincident is
+   accepted: IISPH and DFSPH push such overlaps apart, see def.max_compression); n = 0 does
+   nothing. Cost: a pass over the world's particles and a table of the n new ones. */
 SPHDEF sph_status sph_add_fluid(sph_world* w, int phase, size_t n, const sph_real* x,
                                 const sph_real* v);
 /* The same with a mass m[i] [kg] and a density rho[i] [kg/m^3] per particle (either NULL: the
@@ -4166,6 +4175,108 @@ static sph_status sph__check_fluid(sph_world* w, const char* fn, size_t n, const
     return SPH_OK;
 }
 
+/* Fluid particles added where others already are (within SPH__COINCIDENT spacings: the same
+   box filled twice, an array with a particle twice). Coincident particles never separate: each
+   pair's kernel gradient is zero, so they move as one particle of twice the mass (WCSPH ran a
+   box filled twice for 2 s at twice the weight without a sign; IISPH and DFSPH threw its
+   particles at 60 m/s). Not coincident but close, as an emitter's particles landing between
+   others, is left to the solvers. The new particles are hashed by cell (side dx); each old and
+   new particle looks in its own cell and, within the distance of a face, the next: O(n + m)
+   time, 2m + 2^k indices of memory for the call. */
+#define SPH__COINCIDENT 1e-3
+typedef enum sph__points { SPH__POINTS_ANY, SPH__POINTS_DISTINCT } sph__points;
+static int sph__in_box(const sph_real* x, size_t dim, const double* lo, const double* hi) {
+    size_t k;
+    for (k = 0; k < dim; ++k)
+        if ((double)x[k] < lo[k] || (double)x[k] > hi[k]) return 0;
+    return 1;
+}
+static sph_status sph__check_coincident(sph_world* w, const char* fn, size_t m, const sph_real* x,
+                                        sph__points given) {
+    const size_t dim = (size_t)w->dim, n = w->n;
+    const double inv = 1 / (double)w->dx, eps = SPH__COINCIDENT;
+    double blo[3], bhi[3];
+    size_t nh = 16, i, k, *head, *next, found_a = 0, found_b = 0, inside = 0;
+    int found = 0;
+    if (m == 0) return SPH_OK;
+    /* the call's bounding box, eps wider; distinct points (sph_fill_box's lattice) need only be
+       checked against the world's particles in it, and not at all when there are none */
+    for (k = 0; k < dim; ++k) {
+        blo[k] = 1e300;
+        bhi[k] = -1e300;
+    }
+    for (i = 0; i < m * dim; ++i) {
+        if ((double)x[i] < blo[i % dim]) blo[i % dim] = (double)x[i];
+        if ((double)x[i] > bhi[i % dim]) bhi[i % dim] = (double)x[i];
+    }
+    for (k = 0; k < dim; ++k) {
+        blo[k] -= eps * (double)w->dx;
+        bhi[k] += eps * (double)w->dx;
+    }
+    for (i = 0; i < n; ++i) inside += (size_t)sph__in_box(w->x + i * dim, dim, blo, bhi);
+    if (given == SPH__POINTS_DISTINCT && inside == 0) return SPH_OK;
+    while (nh < 2 * m) nh *= 2;
+    head = (size_t*)SPH_MALLOC((nh + m) * sizeof(size_t));
+    if (!head) return sph__fail(w, SPH_ERR_NOMEM, -1, "%s: out of memory", fn);
+    next = head + nh;
+    for (i = 0; i < nh; ++i) head[i] = (size_t)-1;
+    for (i = 0; i < m; ++i) { /* the call's particles by cell */
+        uint64_t hsh = 1469598103934665603ull;
+        for (k = 0; k < dim; ++k)
+            hsh = (hsh ^ (uint64_t)(int64_t)floor((double)x[i * dim + k] * inv)) * 1099511628211ull;
+        next[i] = head[hsh & (nh - 1)];
+        head[hsh & (nh - 1)] = i;
+    }
+    /* each point of the world (i < n) inside the box and of the call (n + i): every cell within
+       eps of it */
+    for (i = 0; i < (given == SPH__POINTS_DISTINCT ? n : n + m) && !found; ++i) {
+        const sph_real* xi = i < n ? w->x + i * dim : x + (i - n) * dim;
+        double c[3] = {0, 0, 0}, f[3] = {0, 0, 0};
+        int corner;
+        if (i < n && !sph__in_box(xi, dim, blo, bhi)) continue;
+        for (k = 0; k < dim; ++k) {
+            c[k] = floor((double)xi[k] * inv);
+            f[k] = (double)xi[k] * inv - c[k];
+        }
+        for (corner = 0; corner < (1 << (int)dim) && !found; ++corner) {
+            double cc[3] = {0, 0, 0};
+            uint64_t hsh = 1469598103934665603ull;
+            size_t j;
+            for (k = 0; k < dim; ++k) {
+                const int up = (corner >> k) & 1;
+                if (up && !(f[k] < eps || f[k] > 1 - eps)) break;
+                cc[k] = c[k] + (up ? (f[k] < eps ? -1 : 1) : 0);
+                hsh = (hsh ^ (uint64_t)(int64_t)cc[k]) * 1099511628211ull;
+            }
+            if (k < dim) continue;
+            for (j = head[hsh & (nh - 1)]; j != (size_t)-1 && !found; j = next[j]) {
+                double d2 = 0;
+                for (k = 0; k < dim; ++k) {
+                    const double d = ((double)x[j * dim + k] - (double)xi[k]) * inv;
+                    d2 += d * d;
+                }
+                if (d2 < eps * eps && (i < n || j != i - n)) {
+                    found = 1;
+                    found_a = j;
+                    found_b = i;
+                }
+            }
+        }
+    }
+    SPH_FREE(head);
+    if (!found) return SPH_OK;
+    if (found_b < n)
+        return sph__fail(w, SPH_ERR_ARG, (long)found_a,
+                         "%s: particle %zu lies within %g spacings of fluid particle %zu (id %u) "
+                         "already in the world (the same fluid added twice?): coincident "
+                         "particles never separate; nothing added",
+                         fn, found_a, eps, found_b, (unsigned)w->id[found_b]);
+    return sph__fail(w, SPH_ERR_ARG, (long)found_a,
+                     "%s: particles %zu and %zu lie within %g spacings of each other: coincident "
+                     "particles never separate; nothing added",
+                     fn, found_a, found_b - n, eps);
+}
+
 static sph_status sph__add_fluid_checked(sph_world* w, const char* fn, int phase, size_t n,
                                          const sph_real* x, const sph_real* v, const sph_real* m,
                                          const sph_real* rho) {
@@ -4174,6 +4285,7 @@ static sph_status sph__add_fluid_checked(sph_world* w, const char* fn, int phase
     if (!sph__check_phase(w, fn, phase)) return SPH_ERR_ARG;
     if (n == 0) return SPH_OK;
     if ((s = sph__check_fluid(w, fn, n, x, v, m, rho)) != SPH_OK) return s;
+    if ((s = sph__check_coincident(w, fn, n, x, SPH__POINTS_ANY)) != SPH_OK) return s;
     return sph__append_fluid(w, phase, n, x, v, w->phases[phase].mass, m, rho);
 }
 
@@ -4249,8 +4361,10 @@ SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, cons
     /* whole spacings keep the phase's mass bit for bit (no mass array for them) */
     for (k = 0; k < dim; ++k)
         if (sp[k] != w->dx) break;
-    s = sph__append_fluid(w, phase, total, pts, NULL,
-                          k == dim ? w->phases[phase].mass : (sph_real)mass, NULL, NULL);
+    s = sph__check_coincident(w, "sph_fill_box", total, pts, SPH__POINTS_DISTINCT);
+    if (s == SPH_OK)
+        s = sph__append_fluid(w, phase, total, pts, NULL,
+                              k == dim ? w->phases[phase].mass : (sph_real)mass, NULL, NULL);
     SPH_FREE(pts);
     if (s == SPH_OK)
         for (k = 0; k < 3; ++k) w->fill_spacing[k] = sp[k];
@@ -6988,6 +7102,15 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
        wall fraction check_walls allows (lattice walls of given volumes only) */
     const double dmax = (double)w->def.max_displacement * (double)w->dx,
                  dt2 = w->stats.dt * w->stats.dt;
+    /* max_compression fails a step that compressed a particle past it, not one that started
+       with it so: a compression a host put in (particles placed into others: an emitter, a
+       second fill of the same box) no smaller step can undo, and sph_advance's retries would
+       all fail. IISPH and DFSPH sum rho at the step's start: their solves check the density
+       they predict for its end instead (sph__step_iisph, sph__step_dfsph). PCISPH's rho is its
+       last prediction, the others' the step's end */
+    const double cmax = w->priv.solver == SPH_SOLVER_IISPH || w->priv.solver == SPH_SOLVER_DFSPH
+                            ? 0
+                            : (double)w->def.max_compression;
     const int tank = final && w->def.check_walls && w->priv.tanks == 1 && !w->def.boundary_motion;
     const int walls = final && w->def.check_walls && c->has_b && w->nb > 0 &&
                       w->def.boundary_volume != SPH_BVOL_AKINCI && w->priv.wall_fraction_max > 0;
@@ -7129,8 +7252,7 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                must stay real: p + p_inf >= 0, i.e. rho e >= p_inf */
             else if (c->pc[w->phase[i]].gas && c->e && w->rho[i] * c->e[i] < c->pc[w->phase[i]].pinf)
                 bad = SPH__BAD_ENERGY;
-            else if (w->def.max_compression > 0 && err > (double)w->def.max_compression &&
-                     !c->pc[w->phase[i]].gas)
+            else if (cmax > 0 && err > cmax && !c->pc[w->phase[i]].gas)
                 bad = SPH__BAD_COMPRESSION;
             else if (vlim > 0 && v2 > (double)vlim * (double)vlim) bad = SPH__BAD_SPEED;
             else if (dmax > 0 && v2 * dt2 > dmax * dmax) bad = SPH__BAD_DISPLACEMENT;
@@ -7220,6 +7342,19 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                              (unsigned long long)w->steps, w->time, i, (unsigned)w->id[i],
                              (double)w->rho[i]);
         case SPH__BAD_COMPRESSION:
+            /* PCISPH keeps the step's starting density: compressed there already, the cause is
+               the input, which no smaller step undoes */
+            if (w->priv.solver == SPH_SOLVER_PCISPH &&
+                (double)(w->priv.rho_n[i] * c->pc[w->phase[i]].inv_rho0) - 1 >
+                    (double)w->def.max_compression)
+                return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
+                                 "step %llu (t = %g s): fluid particle %zu (id %u) compressed to "
+                                 "rho/rho0 = %g (max_compression %g), and to %g at the step's "
+                                 "start already: particles placed into others? (IISPH and "
+                                 "DFSPH push such overlaps apart)",
+                                 (unsigned long long)w->steps, w->time, i, (unsigned)w->id[i], rr,
+                                 (double)w->def.max_compression,
+                                 (double)(w->priv.rho_n[i] * c->pc[w->phase[i]].inv_rho0));
             return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
                              "step %llu (t = %g s): fluid particle %zu (id %u) compressed to "
                              "rho/rho0 = %g (max_compression %g): time step too large or "

@@ -1,7 +1,7 @@
 /* tests/test_hostile.c - hostile input (issue 19): loaded files checked like the API's input,
    coordinates too far from the origin for the spacing, wall boxes at O(surface) cost, periodic
    grids with points far outside the box, the force callback named when it writes a non-finite
-   value. Each test failed on the sph.h before its fix. */
+   value, fluid added onto fluid. Each test failed on the sph.h before its fix. */
 #include "harness.h"
 #include "alloc.h"
 #include "../sph.h"
@@ -914,7 +914,130 @@ static void test_tank_check(void) {
         }
 }
 
+/* Fluid added where fluid already is: the same box filled twice, or an array holding a particle
+   twice (or within 1e-3 spacings of one), is refused with SPH_ERR_ARG and a message naming both
+   particles, nothing added (coincident particles have a zero kernel gradient between them and
+   never separate: WCSPH ran a box filled twice at twice its weight without a sign, IISPH and
+   DFSPH threw its particles at 60 m/s). Close but not coincident is accepted: 0.3 spacings off,
+   or particles of a new box that only touch the old one. 2D and 3D. */
+static void test_coincident_refused(void) {
+    int dim;
+    for (dim = 2; dim <= 3; ++dim) {
+        sph_world_def d = sph_world_def_default(dim);
+        sph_world w;
+        sph_phase water;
+        const sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)0.2, (sph_real)0.2, (sph_real)0.2};
+        const sph_real lo2[3] = {(sph_real)0.2, 0, 0}, hi2[3] = {(sph_real)0.3, (sph_real)0.2, (sph_real)0.2};
+        sph_real x[6];
+        size_t n0;
+        int k;
+        memset(&water, 0, sizeof water);
+        water.rest_density = 1000;
+        d.spacing = (sph_real)0.02;
+        CHECK(sph_world_init(&w, &d) == SPH_OK && sph_world_add_phase(&w, &water) == 0 &&
+              sph_fill_box(&w, 0, lo, hi) == SPH_OK);
+        n0 = w.n;
+        CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_ERR_ARG); /* the same box again */
+        CHECK_MSG(strstr(w.error, "sph_fill_box") && strstr(w.error, "never separate"), "%s", w.error);
+        CHECK_EQ_INT(w.n, n0);
+        /* one particle 1e-4 spacings from particle 5, one 0.3 spacings from particle 9 */
+        for (k = 0; k < dim; ++k) {
+            x[k] = w.x[5 * (size_t)dim + (size_t)k] + (sph_real)(k == 0 ? 2e-6 : 0);
+            x[dim + k] = w.x[9 * (size_t)dim + (size_t)k] + (sph_real)(k == 1 ? 0.006 : 0);
+        }
+        CHECK_EQ_INT(sph_add_fluid(&w, 0, 2, x, NULL), SPH_ERR_ARG);
+        CHECK_MSG(strstr(w.error, "particle 0 lies within") && strstr(w.error, "(id 5)"), "%s", w.error);
+        CHECK_EQ_INT(w.n, n0);
+        CHECK_EQ_INT(sph_add_fluid(&w, 0, 1, x + dim, NULL), SPH_OK); /* 0.3 dx off: accepted */
+        CHECK_EQ_INT(w.n, n0 + 1);
+        /* twice in one call, far from the rest */
+        for (k = 0; k < dim; ++k) x[k] = x[dim + k] = (sph_real)(k == 0 ? 1.0 : 0.5);
+        CHECK_EQ_INT(sph_add_fluid(&w, 0, 2, x, NULL), SPH_ERR_ARG);
+        CHECK_MSG(strstr(w.error, "particles 1 and 0") || strstr(w.error, "particles 0 and 1"), "%s", w.error);
+        CHECK_EQ_INT(w.n, n0 + 1);
+        /* a box beside the first, touching it: accepted */
+        CHECK_EQ_INT(sph_fill_box(&w, 0, lo2, hi2), SPH_OK);
+        sph_world_free(&w);
+    }
+}
+
+/* Fluid added into fluid (an emitter spawning onto a pool): a tank at rest (0.4 m wide, water
+   0.3 m deep, 2D dx 0.02 and 3D dx 0.04), after 0.5 s (3D: 0.25 s) a block of 5 x 5 (x 5) particles whose
+   lowest row lies half a spacing above the top row, 0.3 spacings aside (densities up to 1.35
+   rho0 where it overlaps). Through sph_advance with the defaults: IISPH and DFSPH push the
+   block apart and run on for 1 s (3D: 0.5 s; every frame SPH_OK, nothing outside the tank, the
+   mass with the block exact). Before, max_compression read their density at the step's start, the host's overlap,
+   which no smaller step undoes: sph_advance failed at the block with "time step too large" after
+   12 retries down to 5e-4 of the stable step, and every later call failed the same way. The
+   original PCISPH runs on in 3D; in 2D it does not undo the overlap, and its failure says so
+   (compressed at the step's start already) and leaves the world as it was. */
+static void test_fluid_added_into_fluid(void) {
+    static const int solvers[3] = {SPH_SOLVER_IISPH, SPH_SOLVER_DFSPH, SPH_SOLVER_PCISPH};
+    int dim, q;
+    for (dim = 2; dim <= 3; ++dim)
+        for (q = 0; q < 3; ++q) {
+            const double dx = dim == 2 ? 0.02 : 0.04, W = 0.4, H = 0.3;
+            const int frames = dim == 2 ? 20 : 10; /* 1 s after the block (3D: 0.5 s) */
+            sph_world_def d = sph_world_def_default(dim);
+            sph_world w;
+            sph_phase water;
+            const sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)W, (sph_real)0.6, (sph_real)W},
+                           fhi[3] = {(sph_real)W, (sph_real)H, (sph_real)W};
+            sph_real xs[3 * 125];
+            sph_status s = SPH_OK;
+            size_t m = 0, i, out = 0;
+            double m0, t_add;
+            int a, b, c, f;
+            memset(&water, 0, sizeof water);
+            water.rest_density = 1000;
+            d.solver = (sph_solver)solvers[q];
+            d.spacing = (sph_real)dx;
+            CHECK(sph_world_init(&w, &d) == SPH_OK && sph_world_add_phase(&w, &water) == 0 &&
+                  sph_fill_box(&w, 0, lo, fhi) == SPH_OK &&
+                  sph_add_wall_box(&w, lo, hi, 0, 0) == SPH_OK && sph_set_hydrostatic(&w) == SPH_OK);
+            for (f = 0; f < frames / 2 && s == SPH_OK; ++f) s = sph_advance(&w, (sph_real)0.05);
+            CHECK_MSG(s == SPH_OK, "%s", w.error);
+            for (a = 0; a < 5; ++a)
+                for (b = 0; b < 5; ++b)
+                    for (c = 0; c < (dim == 3 ? 5 : 1); ++c, ++m) {
+                        xs[m * (size_t)dim] = (sph_real)((5.3 + a) * dx);
+                        xs[m * (size_t)dim + 1] = (sph_real)(H - 0.5 * dx + (0.5 + b) * dx);
+                        if (dim == 3) xs[m * 3 + 2] = (sph_real)((5.3 + c) * dx);
+                    }
+            CHECK_EQ_INT(sph_add_fluid(&w, 0, m, xs, NULL), SPH_OK);
+            m0 = sph_world_mass(&w);
+            t_add = w.time;
+            for (f = 0; f < frames && s == SPH_OK; ++f) {
+                s = sph_advance(&w, (sph_real)0.05);
+                for (i = 0; s == SPH_OK && i < w.n; ++i) {
+                    int k;
+                    for (k = 0; k < dim; ++k)
+                        out += (double)w.x[i * (size_t)dim + (size_t)k] < -0.5 * dx ||
+                               (k != 1 && (double)w.x[i * (size_t)dim + (size_t)k] > W + 0.5 * dx);
+                }
+            }
+            TH_NOTE("%dD %s: fluid added into fluid at t = %.2f s: %s, t = %.2f s, %llu steps, "
+                    "largest speed %.3f m/s", dim, solvers[q] == SPH_SOLVER_IISPH ? "IISPH"
+                    : solvers[q] == SPH_SOLVER_DFSPH ? "DFSPH" : "PCISPH", t_add,
+                    s == SPH_OK ? "ok" : w.error, w.time, (unsigned long long)w.steps,
+                    (double)w.stats.v_max);
+            if (solvers[q] == SPH_SOLVER_PCISPH && s != SPH_OK) {
+                CHECK_EQ_INT(s, SPH_ERR_UNSTABLE);
+                CHECK_MSG(strstr(w.error, "at the step's start already"), "%s", w.error);
+                CHECK_NEAR(w.time, t_add, 0);
+            } else {
+                CHECK_MSG(s == SPH_OK, "%s", w.error);
+                CHECK_EQ_INT(out, 0);
+                CHECK_LE(fabs(sph_world_mass(&w) - m0), 1e-12 * m0);
+                CHECK_NEAR(w.time, t_add + 0.05 * frames, 1e-6); /* frames of (sph_real)0.05 */
+            }
+            sph_world_free(&w);
+        }
+}
+
 const th_test tests_hostile[] = {
+    {"hostile/fluid_added_into_fluid", test_fluid_added_into_fluid},
+    {"hostile/coincident_fluid_refused", test_coincident_refused},
     {"hostile/tank_check_names_escaped_particle", test_tank_check},
     {"hostile/wall_box_matches_lattice_walk", test_wall_box_matches_lattice_walk},
     {"hostile/wall_box_cost_follows_surface", test_wall_box_cost_follows_surface},
