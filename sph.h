@@ -411,8 +411,9 @@ int main(void) {
    Functions that can fail return sph_status; w.error holds a message with the detail (field,
    particle index and id, value) and w.error_index the particle. Bad input (an invalid def field
    or phase, non-finite positions or velocities, dt <= 0, a bad phase index, fluid added within
-   1e-3 spacings of fluid already there or of itself: the same box filled twice) is rejected
-   before anything changes. A blow-up (a non-finite value, density <= 0, compression beyond
+   1e-3 spacings of fluid already there or of itself: the same box filled twice; at the next
+   step, fluid placed inside the layers of lattice walls, sph__check_placed) is rejected before
+   anything changes. A blow-up (a non-finite value, density <= 0, compression beyond
    def.max_compression, a speed beyond def.max_speed's bound, a particle moving more than
    def.max_displacement spacings in one step or ending inside a wall's layers, def.check_walls;
    for PCISPH, IISPH, DFSPH and PBF without force callback or moving walls, a mechanical energy
@@ -607,8 +608,9 @@ typedef double sph_real;
 
 /* Size of the error message buffer kept in the world: room for sph_advance's account of a
    failed sub-step together with the failing step's own message (at 256 bytes the reason, e.g.
-   which wall a particle entered, was cut off). */
-#define SPH_ERROR_SIZE 512
+   which wall a particle entered, was cut off; at 512 the end of PCISPH's account of a particle
+   compressed at its step's start, after sph_advance's hint on fluid just added). */
+#define SPH_ERROR_SIZE 1024
 
 #ifdef __cplusplus
 extern "C" {
@@ -1367,6 +1369,9 @@ typedef struct sph__private {
     int b_thin_on;                  /* b_thin holds the walls' present order                    */
     sph_real wall_fraction_max;     /* check_walls: wall volume fraction of a particle on the
                                        first layer of a flat lattice wall                          */
+    int placed;                     /* fluid or walls added since the last step began
+                                       (sph__check_placed)                                         */
+    size_t placed_from;             /* the first fluid index added since (0 once walls were)     */
     sph_real tank_lo[3], tank_hi[3]; /* check_walls: the inner faces of the closed box of
                                        sph_add_wall_box (sph__tank_check) [m]                    */
     int tanks;                      /* closed boxes added; -1: a fluid particle was added outside
@@ -4125,6 +4130,8 @@ static sph_status sph__append_fluid(sph_world* w, int phase, size_t n, const sph
     }
     if (!w->priv.have_mass) { w->priv.have_mass = 1; w->mass = mass; }
     w->n += n;
+    if (!w->priv.placed || base < w->priv.placed_from) w->priv.placed_from = base;
+    w->priv.placed = 1;
     sph__tank_note(w, base);
     return SPH_OK;
 }
@@ -4394,6 +4401,8 @@ static sph_status sph__append_boundary(sph_world* w, size_t n, const sph_real* x
         w->b_body[j] = (uint16_t)body;
     }
     w->nb += n;
+    w->priv.placed = 1;
+    w->priv.placed_from = 0; /* every fluid particle may now lie in the new walls */
     w->priv.b_dirty = 1;
     return SPH_OK;
 }
@@ -7636,6 +7645,74 @@ static sph_status sph__check_def_now(sph_world* w) {
     return SPH_OK;
 }
 
+/* Fluid placed inside walls (check_walls, lattice walls of given volumes): before the first step
+   after the host added fluid or walls, a fluid particle whose wall volume fraction
+   sum_b V_b W_ib / S lies beyond that of the wall's first layer (sph__wall_fraction_limit; a fill
+   box reaching into sph_add_wall_box's layers, an obstacle placed into the fluid) is bad input:
+   SPH_ERR_ARG, named, the world unchanged. Left to the step it failed as a compression or a speed
+   ("time step too large", a particle at 39 m/s) after every retry. Fluid closer to a wall than
+   the lattice's spacing but short of its first layer is left to the wall contact. Only the fluid
+   added since the last step is checked, unless walls were added: the walls are sorted into a
+   grid of their own (sph_grid) and each fluid particle queried, about a neighbour search. */
+static sph_status sph__check_placed(sph_world* w) {
+    const size_t D = (size_t)w->dim;
+    const sph_real R = w->kernel.radius;
+    sph_grid g;
+    uint32_t* buf;
+    size_t cap = 256, i, bad = (size_t)-1;
+    double fbad = 0;
+    sph_status s;
+    if (!w->priv.placed) return SPH_OK;
+    if (!w->def.check_walls || w->nb == 0 || w->def.boundary_volume == SPH_BVOL_AKINCI ||
+        !(w->priv.wall_fraction_max > 0) || w->priv.placed_from >= w->n) {
+        w->priv.placed = 0;
+        return SPH_OK;
+    }
+    s = sph_grid_init(&g, w->dim, R, w->def.periodic, w->def.domain_lo, w->def.domain_hi);
+    if (s != SPH_OK) return sph__fail(w, s, -1, "step: the walls' grid: %s", sph_status_string(s));
+    buf = (uint32_t*)SPH_MALLOC(cap * sizeof(uint32_t));
+    s = buf ? sph_grid_build(&g, w->b_x, w->nb) : SPH_ERR_NOMEM;
+    for (i = w->priv.placed_from; s == SPH_OK && i < w->n && bad == (size_t)-1; ++i) {
+        const sph_real* xi = w->x + i * D;
+        size_t m = sph_grid_query(&g, w->b_x, xi, R, buf, cap), q;
+        double sum = 0;
+        if (m > cap) { /* more wall neighbours than room: a larger buffer, the query again */
+            uint32_t* more = (uint32_t*)SPH_MALLOC(m * sizeof(uint32_t));
+            if (!more) { s = SPH_ERR_NOMEM; break; }
+            SPH_FREE(buf);
+            buf = more;
+            cap = m;
+            m = sph_grid_query(&g, w->b_x, xi, R, buf, cap);
+        }
+        for (q = 0; q < m; ++q) {
+            sph_real d[3] = {0, 0, 0}, r2 = 0;
+            size_t k;
+            sph_grid_delta(&g, xi, w->b_x + (size_t)buf[q] * D, d);
+            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+            sum += (double)w->b_vol[buf[q]] * (double)sph_kernel_w(&w->kernel, (sph_real)sqrt((double)r2));
+        }
+        if (sum / (double)w->priv.lattice_sum > (double)w->priv.wall_fraction_max) {
+            bad = i;
+            fbad = sum / (double)w->priv.lattice_sum;
+        }
+    }
+    SPH_FREE(buf);
+    sph_grid_free(&g);
+    if (s != SPH_OK) return sph__fail(w, s, -1, "step: out of memory (the walls' grid)");
+    if (bad != (size_t)-1) {
+        const sph_real* xb = w->x + bad * D;
+        return sph__fail(w, SPH_ERR_ARG, (long)bad,
+                         "fluid particle %zu (id %u) at (%g, %g, %g) lies inside the wall layers "
+                         "(wall volume fraction %g > %g, the first layer's): fluid placed where "
+                         "walls are (a fill box reaching into the walls, an obstacle placed into "
+                         "the fluid?); remove it",
+                         bad, (unsigned)w->id[bad], (double)xb[0], D > 1 ? (double)xb[1] : 0.0,
+                         D > 2 ? (double)xb[2] : 0.0, fbad, (double)w->priv.wall_fraction_max);
+    }
+    w->priv.placed = 0;
+    return SPH_OK;
+}
+
 static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) {
     sph_status s;
     int k;
@@ -7649,6 +7726,8 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
     s = sph__check_def_now(w);
     if (s != SPH_OK) return s;
     s = sph__check_step_input(w, dt);
+    if (s != SPH_OK) return s;
+    s = sph__check_placed(w);
     if (s != SPH_OK) return s;
     /* scratch first, so that running out of memory here changes nothing */
     s = sph__reserve_blocks(w);
@@ -10422,10 +10501,11 @@ static void sph__snapshot_restore(sph_world* w, int slot) {
 
 SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
     double t_end;
-    int substeps = 0, retries = 0, in_row = 0, restarts = 0, first = 1;
+    int substeps = 0, retries = 0, in_row = 0, restarts = 0, first = 1, placed;
     double dt_min = 0, dt_last = 0, iterations = 0, factor0;
     sph_status s;
     if (!w) return SPH_ERR_ARG;
+    placed = w->priv.placed; /* the host added fluid or walls since the last step */
     if (!sph__finite((double)duration) || duration < 0)
         return sph__fail(w, SPH_ERR_ARG, -1, "sph_advance: duration = %g: must be finite and >= 0",
                          (double)duration);
@@ -10562,8 +10642,13 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
                 return sph__fail(w, s, idx,
                                  "sph_advance: the sub-step failed (%d in a row), the last at dt "
                                  "= %g s (%g of the stable step); the world is as before the "
-                                 "call (t = %g s). Last failure: %s",
-                                 in_row + 1, dt, dt / dt_stable, t, msg);
+                                 "call (t = %g s).%s Last failure: %s",
+                                 in_row + 1, dt, dt / dt_stable, t,
+                                 placed ? " Fluid or walls were added just before the call: "
+                                          "do they overlap (fluid closer than a spacing to walls "
+                                          "or to other fluid starts compressed)?"
+                                        : "",
+                                 msg);
             w->status = s; /* other errors keep their own message */
             memcpy(w->error, msg, sizeof msg);
             w->error_index = idx;

@@ -1,7 +1,7 @@
 /* tests/test_hostile.c - hostile input (issue 19): loaded files checked like the API's input,
    coordinates too far from the origin for the spacing, wall boxes at O(surface) cost, periodic
    grids with points far outside the box, the force callback named when it writes a non-finite
-   value, fluid added onto fluid. Each test failed on the sph.h before its fix. */
+   value, fluid added onto fluid or into walls. Each test failed on the sph.h before its fix. */
 #include "harness.h"
 #include "alloc.h"
 #include "../sph.h"
@@ -1035,7 +1035,66 @@ static void test_fluid_added_into_fluid(void) {
         }
 }
 
+/* Fluid placed inside walls: a fill box reaching one spacing into sph_add_wall_box's layers (its
+   outer rows on the first layer's particles), and a block of boundary particles a host places
+   into a filled tank, are refused by the first step (sph_advance and sph_step_*) with
+   SPH_ERR_ARG naming a particle "inside the wall layers", time and particles as before (not
+   even sorted). Before,
+   every solver failed that first step after all its retries as a compression or a speed (IISPH:
+   a particle at 39 m/s), which pointed at the step size. Fluid a host places closer to a wall
+   than the lattice's spacing but short of its first layer is left to the wall contact, and
+   sph_advance's failure, if the step fails, now asks whether fluid and walls just added
+   overlap. 2D and 3D. */
+static void test_fluid_inside_walls(void) {
+    int dim, mode;
+    for (dim = 2; dim <= 3; ++dim)
+        for (mode = 0; mode < 3; ++mode) {
+            const double dx = dim == 2 ? 0.02 : 0.04;
+            sph_world_def d = sph_world_def_default(dim);
+            sph_world w;
+            sph_phase water;
+            const sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)0.4, (sph_real)0.6, (sph_real)0.4},
+                           fin[3] = {(sph_real)-dx, (sph_real)-dx, (sph_real)-dx},
+                           fhi[3] = {(sph_real)0.4, (sph_real)0.3, (sph_real)0.4};
+            sph_real xb[3 * 64], *x0;
+            size_t nb = 0, n0;
+            sph_status s;
+            int a, b, c;
+            memset(&water, 0, sizeof water);
+            water.rest_density = 1000;
+            d.solver = mode == 2 ? SPH_SOLVER_WCSPH : SPH_SOLVER_IISPH;
+            d.spacing = (sph_real)dx;
+            CHECK(sph_world_init(&w, &d) == SPH_OK && sph_world_add_phase(&w, &water) == 0);
+            CHECK_EQ_INT(sph_fill_box(&w, 0, mode == 0 ? fin : lo, fhi), SPH_OK);
+            CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 0, 0), SPH_OK);
+            if (mode > 0) { /* a 4 x 4 (x 4) block on the fluid's lattice, in the fluid */
+                for (a = 0; a < 4; ++a)
+                    for (b = 0; b < 4; ++b)
+                        for (c = 0; c < (dim == 3 ? 4 : 1); ++c, ++nb) {
+                            xb[nb * (size_t)dim] = (sph_real)((4.5 + a) * dx);
+                            xb[nb * (size_t)dim + 1] = (sph_real)((2.5 + b) * dx);
+                            if (dim == 3) xb[nb * 3 + 2] = (sph_real)((4.5 + c) * dx);
+                        }
+                CHECK_EQ_INT(sph_add_boundary(&w, nb, xb, NULL, 1), SPH_OK);
+            }
+            n0 = w.n;
+            x0 = (sph_real*)malloc(n0 * (size_t)dim * sizeof(sph_real));
+            memcpy(x0, w.x, n0 * (size_t)dim * sizeof(sph_real));
+            s = mode == 1 ? sph_step_iisph(&w, (sph_real)1e-3) : sph_advance(&w, (sph_real)0.05);
+            TH_NOTE("%dD %s: %s", dim, mode == 0 ? "fill box into the walls" : "block into the fluid",
+                    w.error);
+            CHECK_EQ_INT(s, SPH_ERR_ARG);
+            CHECK_MSG(strstr(w.error, "inside the wall layers") != NULL, "%s", w.error);
+            CHECK_NEAR(w.time, 0, 0);
+            CHECK_EQ_INT(w.n, n0);
+            CHECK(memcmp(x0, w.x, n0 * (size_t)dim * sizeof(sph_real)) == 0); /* not even sorted */
+            free(x0);
+            sph_world_free(&w);
+        }
+}
+
 const th_test tests_hostile[] = {
+    {"hostile/fluid_inside_walls_refused", test_fluid_inside_walls},
     {"hostile/fluid_added_into_fluid", test_fluid_added_into_fluid},
     {"hostile/coincident_fluid_refused", test_coincident_refused},
     {"hostile/tank_check_names_escaped_particle", test_tank_check},
