@@ -221,9 +221,9 @@ int main(void) {
    failing with it and holding with particle density). With Stormer-Verlet the predicted density
    is constrained with 0.47 v^n + 0.53 v* rather than the midpoint velocity, which would leave the
    compression rate of the last step undamped (derived in >>pcisph; on the layered column of
-   PHASES it took the speed from 3.9 % to 0.5 % of sqrt(g H)). The original PCISPH cannot hold two phases
-   of different density at all (summation smears the mass jump): it fails within a few steps and
-   says so. The original's step is also bounded by its largest pressure, dt <= 0.25 h /
+   PHASES it took the speed from 3.9 % to 0.5 % of sqrt(g H)). The original PCISPH holds phases
+   of different density only at ratios near 1 (summation smears the mass jump; oil of 850 over
+   water ran 3 s): at 0.5 it fails in its first step and says so. The original's step is also bounded by its largest pressure, dt <= 0.25 h /
    sqrt(p_max / rho0): its correction at the predicted positions diverges above (derived in
    sph_stable_dt). delta-SPH uses c = cfl h / dt, the speed for which dt is the acoustic step.
 
@@ -263,8 +263,9 @@ int main(void) {
    SPH_ERR_NOT_CONVERGED. Both wall schemes work on open tanks (EXTRAPOLATE runs the divergence
    solve with mirrored walls: its pressure balances no weight); a fluid that
    fills a closed box is solved with zero wall pressure whatever the scheme (with walls that
-   copy the fluid's pressure it has no pressure level: see sph__enclosed). Phases may differ in rest density and mass (summation
-   density: ratios near 1). Measured (tests/test_dfsph.c, 2D dam break, 20 particles per a, the
+   copy the fluid's pressure it has no pressure level: see sph__enclosed). Phases may differ in rest density and mass
+   down to a ratio of 0.75 (summation density smears the mass jump; below it IISPH and DFSPH
+   refuse to step, see SPH__SUMMED_RATIO_MIN). Measured (tests/test_dfsph.c, 2D dam break, 20 particles per a, the
    same fixed dt, one thread): 3.5 iterations per step (1.0 of them divergence) against IISPH's
    2.6, 1.41 against 1.30 ms per step, the same compression and front; on a tank at rest 31
    iterations per step like IISPH's 30. Choosing: WCSPH for small steps and simple code, IISPH
@@ -492,10 +493,12 @@ int main(void) {
    density: the symmetric gradient, the multiphase gradient with the mass continuity equation (a
    light particle takes its heavy neighbours' masses), SPH_PGRAD_DIFFERENCE on a 10:1 column (it
    is for interfaces that should move, see WCSPH), the original PCISPH, IISPH, DFSPH and PBF
-   (summation density, or PBF's constraint on it, smears the mass jump: ratios near 1 only). On
-   the column they fail with SPH_ERR_UNSTABLE from sph_advance (WCSPH symmetric with particle
-   density, multiphase with continuity, IISPH, DFSPH; the original PCISPH within a few steps,
-   tests/test_pcisph.c),
+   (summation density, or PBF's constraint on it, smears the mass jump: ratios near 1 only;
+   IISPH and DFSPH refuse rest densities in a ratio below 0.75 with SPH_ERR_ARG: at 0.5 a light
+   blob rising in water gained 0.4-0.6 M g dx in its first second, every frame SPH_OK, and on
+   this column they ran at 2.0-2.4 m/s for 0.5 s before failing). On the column the others fail
+   with SPH_ERR_UNSTABLE from sph_advance (WCSPH symmetric with particle density, multiphase
+   with continuity; the original PCISPH within a few steps, tests/test_pcisph.c),
    or run without resting: WCSPH symmetric with continuity 7 % and PBF 72 % of sqrt(g H) after
    0.5 s. None loses a particle silently (tests/test_layers.c checks every frame). Gases and
    1000:1 interfaces: the compressible step (SOLVER: COMPRESSIBLE) with particle density and
@@ -7014,6 +7017,20 @@ SPH__INLINE sph_real sph__rho_floor(const sph__ctx* c, size_t i, sph_real rho) {
     return c->rho_floor && rho < lo ? lo : rho;
 }
 
+/* The least ratio of two liquid phases' rest densities (1: one phase, or phases of one density). */
+static double sph__rest_density_ratio(const sph_world* w) {
+    double lo = 0, hi = 0;
+    int k;
+    for (k = 0; k < w->nphase; ++k) {
+        const double r = (double)w->phases[k].rest_density;
+        if (w->phases[k].eos == SPH_EOS_IDEAL_GAS || w->phases[k].eos == SPH_EOS_STIFFENED_GAS)
+            continue;
+        if (lo == 0 || r < lo) lo = r;
+        if (r > hi) hi = r;
+    }
+    return hi > 0 ? lo / hi : 1;
+}
+
 /* Whether the step carries the density (the continuity equation or Ott & Schnetter's particle
    density) instead of summing it from the positions each step: WCSPH, enhanced PCISPH and the
    compressible step with def.density other than SPH_DENSITY_SUMMATION (IISPH, DFSPH and PBF
@@ -7359,11 +7376,17 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
                                  "step %llu (t = %g s): fluid particle %zu (id %u) compressed to "
                                  "rho/rho0 = %g (max_compression %g), and to %g at the step's "
-                                 "start already: particles placed into others? (IISPH and "
-                                 "DFSPH push such overlaps apart)",
+                                 "start already: %s",
                                  (unsigned long long)w->steps, w->time, i, (unsigned)w->id[i], rr,
                                  (double)w->def.max_compression,
-                                 (double)(w->priv.rho_n[i] * c->pc[w->phase[i]].inv_rho0));
+                                 (double)(w->priv.rho_n[i] * c->pc[w->phase[i]].inv_rho0),
+                                 w->def.density == SPH_DENSITY_SUMMATION &&
+                                         sph__rest_density_ratio(w) < 1
+                                     ? "the summed density smears the mass jump between phases "
+                                       "(the original PCISPH is not for phases of different "
+                                       "density: sph.h, PHASES)"
+                                     : "particles placed into others? (IISPH and DFSPH push "
+                                       "such overlaps apart)");
             return sph__fail(w, SPH_ERR_UNSTABLE, (long)i,
                              "step %llu (t = %g s): fluid particle %zu (id %u) compressed to "
                              "rho/rho0 = %g (max_compression %g): time step too large or "
@@ -7713,6 +7736,14 @@ static sph_status sph__check_placed(sph_world* w) {
     return SPH_OK;
 }
 
+/* IISPH and DFSPH sum the density, which smears the mass jump between phases: a blob of light
+   fluid rising in water (2D, dx 0.02, 1 s, through sph_advance) gained kinetic + potential
+   energy, in units of M g dx: 0 at a rest-density ratio of 0.8, 0.005 (IISPH) and 0 (DFSPH) at
+   0.75, 0.045 and 0.020 at 0.7, 0.09 and 0.12 at 0.6, 0.64 and 0.39 at 0.5; at 0.2 it reached
+   21 m/s in its first frame, every frame SPH_OK (the energy check's allowance grows with the
+   kinetic energy the spurious pressure makes). Below this ratio they refuse to step. */
+#define SPH__SUMMED_RATIO_MIN 0.75
+
 static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) {
     sph_status s;
     int k;
@@ -7725,6 +7756,16 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
                                  "internal energy only sph_step_compressible evolves", k);
     s = sph__check_def_now(w);
     if (s != SPH_OK) return s;
+    if ((solver == SPH_SOLVER_IISPH || solver == SPH_SOLVER_DFSPH) &&
+        sph__rest_density_ratio(w) < SPH__SUMMED_RATIO_MIN)
+        return sph__fail(w, SPH_ERR_ARG, -1,
+                         "step: phases of rest densities in the ratio %g (below %g): %s sums the "
+                         "density, which smears the mass jump between phases (a light blob "
+                         "rising in water gains energy); for phases of different density use "
+                         "enhanced PCISPH or WCSPH with def.density = SPH_DENSITY_PARTICLE "
+                         "(sph.h, PHASES)",
+                         sph__rest_density_ratio(w), SPH__SUMMED_RATIO_MIN,
+                         solver == SPH_SOLVER_IISPH ? "IISPH" : "DFSPH");
     s = sph__check_step_input(w, dt);
     if (s != SPH_OK) return s;
     s = sph__check_placed(w);
@@ -10503,9 +10544,13 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
     double t_end;
     int substeps = 0, retries = 0, in_row = 0, restarts = 0, first = 1, placed;
     double dt_min = 0, dt_last = 0, iterations = 0, factor0;
+    uint64_t steps0;
     sph_status s;
     if (!w) return SPH_ERR_ARG;
-    placed = w->priv.placed; /* the host added fluid or walls since the last step */
+    /* the host added fluid or walls since the last step, all of one rest density (phases of
+       different density start off rest density for a solver that sums it) */
+    placed = w->priv.placed && sph__rest_density_ratio(w) == 1;
+    steps0 = w->steps;
     if (!sph__finite((double)duration) || duration < 0)
         return sph__fail(w, SPH_ERR_ARG, -1, "sph_advance: duration = %g: must be finite and >= 0",
                          (double)duration);
@@ -10623,6 +10668,7 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
             const size_t count = boundary ? w->nb : w->n;
             const uint32_t* ids = boundary ? w->b_id : w->id;
             const uint32_t id = idx >= 0 && (size_t)idx < count ? ids[idx] : 0;
+            const int early = placed && w->steps - steps0 <= 10; /* within 10 steps of the adding */
             double t;
             memcpy(msg, w->error, sizeof msg);
             sph__snapshot_restore(w, 0);
@@ -10644,7 +10690,7 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
                                  "= %g s (%g of the stable step); the world is as before the "
                                  "call (t = %g s).%s Last failure: %s",
                                  in_row + 1, dt, dt / dt_stable, t,
-                                 placed ? " Fluid or walls were added just before the call: "
+                                 early ? " Fluid or walls were added just before the call: "
                                           "do they overlap (fluid closer than a spacing to walls "
                                           "or to other fluid starts compressed)?"
                                         : "",

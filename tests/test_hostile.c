@@ -1,7 +1,8 @@
 /* tests/test_hostile.c - hostile input (issue 19): loaded files checked like the API's input,
    coordinates too far from the origin for the spacing, wall boxes at O(surface) cost, periodic
    grids with points far outside the box, the force callback named when it writes a non-finite
-   value, fluid added onto fluid or into walls. Each test failed on the sph.h before its fix. */
+   value, fluid added onto fluid or into walls, phases too different for a summed density. Each
+   test failed on the sph.h before its fix. */
 #include "harness.h"
 #include "alloc.h"
 #include "../sph.h"
@@ -1093,7 +1094,72 @@ static void test_fluid_inside_walls(void) {
         }
 }
 
+/* Phases of different rest density under IISPH and DFSPH, which sum the density (smearing the
+   mass jump between phases): light fluid (800, then 700 kg/m^3) layered over water in a tank,
+   0.4 m wide, 0.16 + 0.14 m deep, dx 0.02, through sph_advance. At a ratio of 0.8 they run
+   (0.5 s, nothing outside, the energy not above its start by more than 0.01 M g dx); below 0.75
+   (SPH__SUMMED_RATIO_MIN) the first call is refused with SPH_ERR_ARG naming the ratio, the world
+   unchanged. Before, a light blob of 0.5 rising in water gained 0.4-0.6 M g dx in its first
+   second and one of 0.2 reached 21 m/s in its first frame, every frame SPH_OK. */
+static void test_summed_density_phase_ratio(void) {
+    static const int solvers[2] = {SPH_SOLVER_IISPH, SPH_SOLVER_DFSPH};
+    int q, light;
+    for (q = 0; q < 2; ++q)
+        for (light = 800; light >= 700; light -= 100) {
+            const double dx = 0.02;
+            sph_world_def d = sph_world_def_default(2);
+            sph_world w;
+            sph_phase water, oil;
+            const sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)0.4, (sph_real)0.5},
+                           mid[2] = {(sph_real)0.4, (sph_real)0.16},
+                           lo2[2] = {0, (sph_real)0.16}, top[2] = {(sph_real)0.4, (sph_real)0.3};
+            double e0 = 0, e_max = -1e300, M;
+            sph_status s = SPH_OK;
+            size_t i, out = 0;
+            int f;
+            memset(&water, 0, sizeof water);
+            memset(&oil, 0, sizeof oil);
+            water.rest_density = 1000;
+            oil.rest_density = (sph_real)light;
+            d.solver = (sph_solver)solvers[q];
+            d.spacing = (sph_real)dx;
+            CHECK(sph_world_init(&w, &d) == SPH_OK && sph_world_add_phase(&w, &water) == 0 &&
+                  sph_world_add_phase(&w, &oil) == 1 && sph_fill_box(&w, 0, lo, mid) == SPH_OK &&
+                  sph_fill_box(&w, 1, lo2, top) == SPH_OK &&
+                  sph_add_wall_box(&w, lo, hi, 0, 0) == SPH_OK && sph_set_hydrostatic(&w) == SPH_OK);
+            M = sph_world_mass(&w);
+            for (i = 0; i < w.n; ++i)
+                e0 += (double)(w.m ? w.m[i] : w.mass) * 9.81 * (double)w.x[2 * i + 1];
+            for (f = 0; f < 10 && s == SPH_OK; ++f) {
+                double e;
+                s = sph_advance(&w, (sph_real)0.05);
+                if (s != SPH_OK) break;
+                e = w.stats.kinetic_energy;
+                for (i = 0; i < w.n; ++i) {
+                    const double x = (double)w.x[2 * i], y = (double)w.x[2 * i + 1];
+                    e += (double)(w.m ? w.m[i] : w.mass) * 9.81 * y;
+                    out += x < -0.5 * dx || x > 0.4 + 0.5 * dx || y < -0.5 * dx;
+                }
+                if (e > e_max) e_max = e;
+            }
+            TH_NOTE("%s, rest densities %d and 1000: %s; energy above its start %.3g M g dx",
+                    solvers[q] == SPH_SOLVER_IISPH ? "IISPH" : "DFSPH", light,
+                    s == SPH_OK ? "ok" : w.error, s == SPH_OK ? (e_max - e0) / (M * 9.81 * dx) : 0.0);
+            if (light == 800) {
+                CHECK_MSG(s == SPH_OK, "%s", w.error);
+                CHECK_EQ_INT(out, 0);
+                CHECK_LE(e_max - e0, 0.01 * M * 9.81 * dx);
+            } else {
+                CHECK_EQ_INT(s, SPH_ERR_ARG);
+                CHECK_MSG(strstr(w.error, "ratio 0.7") != NULL, "%s", w.error);
+                CHECK_NEAR(w.time, 0, 0);
+            }
+            sph_world_free(&w);
+        }
+}
+
 const th_test tests_hostile[] = {
+    {"hostile/summed_density_phase_ratio", test_summed_density_phase_ratio},
     {"hostile/fluid_inside_walls_refused", test_fluid_inside_walls},
     {"hostile/fluid_added_into_fluid", test_fluid_added_into_fluid},
     {"hostile/coincident_fluid_refused", test_coincident_refused},
