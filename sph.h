@@ -223,9 +223,9 @@ int main(void) {
    compression rate of the last step undamped (derived in >>pcisph; on the layered column of
    PHASES it took the speed from 3.9 % to 0.5 % of sqrt(g H)). The original PCISPH holds phases
    of different density only at ratios near 1 (summation smears the mass jump; oil of 850 over
-   water ran 3 s): at 0.5 it fails in its first step and says so. The original's step is also bounded by its largest pressure, dt <= 0.25 h /
-   sqrt(p_max / rho0): its correction at the predicted positions diverges above (derived in
-   sph_stable_dt). delta-SPH uses c = cfl h / dt, the speed for which dt is the acoustic step.
+   water ran 3 s): at 0.5 it fails in its first step and says so. The original's step is also
+   bounded by its largest pressure, dt <= 0.25 h / sqrt(p_max / rho0): its correction at the
+   predicted positions diverges above (derived in sph_stable_dt). delta-SPH uses c = cfl h / dt, the speed for which dt is the acoustic step.
 
    SOLVER: IISPH (sph_step_iisph, or def.solver = SPH_SOLVER_IISPH)
    Implicit incompressible SPH (Ihmsen et al. 2014; Meiers 2025): summation density, then a pressure
@@ -263,10 +263,10 @@ int main(void) {
    SPH_ERR_NOT_CONVERGED. Both wall schemes work on open tanks (EXTRAPOLATE runs the divergence
    solve with mirrored walls: its pressure balances no weight); a fluid that
    fills a closed box is solved with zero wall pressure whatever the scheme (with walls that
-   copy the fluid's pressure it has no pressure level: see sph__enclosed). Phases may differ in rest density and mass
-   down to a ratio of 0.75 (summation density smears the mass jump; below it IISPH and DFSPH
-   refuse to step, see SPH__SUMMED_RATIO_MIN). Measured (tests/test_dfsph.c, 2D dam break, 20 particles per a, the
-   same fixed dt, one thread): 3.5 iterations per step (1.0 of them divergence) against IISPH's
+   copy the fluid's pressure it has no pressure level: see sph__enclosed). Phases may differ in
+   rest density and mass down to a ratio of 0.75 (summation density smears the mass jump; below
+   it IISPH and DFSPH refuse to step, see SPH__SUMMED_RATIO_MIN). Measured (tests/test_dfsph.c,
+   2D dam break, 20 particles per a, the same fixed dt, one thread): 3.5 iterations per step (1.0 of them divergence) against IISPH's
    2.6, 1.41 against 1.30 ms per step, the same compression and front; on a tank at rest 31
    iterations per step like IISPH's 30. Choosing: WCSPH for small steps and simple code, IISPH
    for large steps on liquids, DFSPH when the velocity field itself must be divergence-free
@@ -420,8 +420,8 @@ int main(void) {
    for PCISPH, IISPH, DFSPH and PBF without force callback or moving walls, a mechanical energy
    (kinetic + gravity's potential) that climbs above the least it has had by more than half the
    largest kinetic energy: walls or solver doing work; PBF under gravity, and gravity along a
-   periodic direction, count as forcing) is reported as SPH_ERR_UNSTABLE at the step where it happens, naming the first offending
-   particle; an iterative pressure solve that stops at max_iterations above its tolerance returns
+   periodic direction, count as forcing) is reported as SPH_ERR_UNSTABLE at the step where it
+   happens, naming the first offending particle; an iterative pressure solve that stops at max_iterations above its tolerance returns
    SPH_ERR_NOT_CONVERGED (the step was taken). sph_advance turns both into retries: the failed
    sub-step is undone bit for bit and taken again at half the step (up to 12 times in a row, the
    pressure solve starting cold), the step grows back by 1.1 per success; a sub-step that fails
@@ -1373,7 +1373,7 @@ typedef struct sph__private {
     sph_real wall_fraction_max;     /* check_walls: wall volume fraction of a particle on the
                                        first layer of a flat lattice wall                          */
     int placed;                     /* fluid or walls added since the last step began
-                                       (sph__check_placed)                                         */
+                                       (sph__check_placed)                                      */
     size_t placed_from;             /* the first fluid index added since (0 once walls were)     */
     sph_real tank_lo[3], tank_hi[3]; /* check_walls: the inner faces of the closed box of
                                        sph_add_wall_box (sph__tank_check) [m]                    */
@@ -7712,7 +7712,8 @@ static sph_status sph__check_placed(sph_world* w) {
             size_t k;
             sph_grid_delta(&g, xi, w->b_x + (size_t)buf[q] * D, d);
             for (k = 0; k < D; ++k) r2 += d[k] * d[k];
-            sum += (double)w->b_vol[buf[q]] * (double)sph_kernel_w(&w->kernel, (sph_real)sqrt((double)r2));
+            sum += (double)w->b_vol[buf[q]] *
+                   (double)sph_kernel_w(&w->kernel, (sph_real)sqrt((double)r2));
         }
         if (sum / (double)w->priv.lattice_sum > (double)w->priv.wall_fraction_max) {
             bad = i;

@@ -928,7 +928,8 @@ static void test_coincident_refused(void) {
         sph_world w;
         sph_phase water;
         const sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)0.2, (sph_real)0.2, (sph_real)0.2};
-        const sph_real lo2[3] = {(sph_real)0.2, 0, 0}, hi2[3] = {(sph_real)0.3, (sph_real)0.2, (sph_real)0.2};
+        const sph_real lo2[3] = {(sph_real)0.2, 0, 0},
+                       hi2[3] = {(sph_real)0.3, (sph_real)0.2, (sph_real)0.2};
         sph_real x[6];
         size_t n0;
         int k;
@@ -939,7 +940,8 @@ static void test_coincident_refused(void) {
               sph_fill_box(&w, 0, lo, hi) == SPH_OK);
         n0 = w.n;
         CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_ERR_ARG); /* the same box again */
-        CHECK_MSG(strstr(w.error, "sph_fill_box") && strstr(w.error, "never separate"), "%s", w.error);
+        CHECK_MSG(strstr(w.error, "sph_fill_box") && strstr(w.error, "never separate"), "%s",
+                  w.error);
         CHECK_EQ_INT(w.n, n0);
         /* one particle 1e-4 spacings from particle 5, one 0.3 spacings from particle 9 */
         for (k = 0; k < dim; ++k) {
@@ -947,14 +949,16 @@ static void test_coincident_refused(void) {
             x[dim + k] = w.x[9 * (size_t)dim + (size_t)k] + (sph_real)(k == 1 ? 0.006 : 0);
         }
         CHECK_EQ_INT(sph_add_fluid(&w, 0, 2, x, NULL), SPH_ERR_ARG);
-        CHECK_MSG(strstr(w.error, "particle 0 lies within") && strstr(w.error, "(id 5)"), "%s", w.error);
+        CHECK_MSG(strstr(w.error, "particle 0 lies within") && strstr(w.error, "(id 5)"), "%s",
+                  w.error);
         CHECK_EQ_INT(w.n, n0);
         CHECK_EQ_INT(sph_add_fluid(&w, 0, 1, x + dim, NULL), SPH_OK); /* 0.3 dx off: accepted */
         CHECK_EQ_INT(w.n, n0 + 1);
         /* twice in one call, far from the rest */
         for (k = 0; k < dim; ++k) x[k] = x[dim + k] = (sph_real)(k == 0 ? 1.0 : 0.5);
         CHECK_EQ_INT(sph_add_fluid(&w, 0, 2, x, NULL), SPH_ERR_ARG);
-        CHECK_MSG(strstr(w.error, "particles 1 and 0") || strstr(w.error, "particles 0 and 1"), "%s", w.error);
+        CHECK_MSG(strstr(w.error, "particles 1 and 0") || strstr(w.error, "particles 0 and 1"),
+                  "%s", w.error);
         CHECK_EQ_INT(w.n, n0 + 1);
         /* a box beside the first, touching it: accepted */
         CHECK_EQ_INT(sph_fill_box(&w, 0, lo2, hi2), SPH_OK);
