@@ -4203,8 +4203,8 @@ static sph_status sph__check_fluid(sph_world* w, const char* fn, size_t n, const
 typedef enum sph__points { SPH__POINTS_ANY, SPH__POINTS_DISTINCT } sph__points;
 static int sph__in_box(const sph_real* x, size_t dim, const double* lo, const double* hi) {
     size_t k;
-    for (k = 0; k < dim; ++k)
-        if ((double)x[k] < lo[k] || (double)x[k] > hi[k]) return 0;
+    for (k = 0; k < dim; ++k) /* a NaN a host wrote into w.x is outside */
+        if (!((double)x[k] >= lo[k] && (double)x[k] <= hi[k])) return 0;
     return 1;
 }
 static sph_status sph__check_coincident(sph_world* w, const char* fn, size_t m, const sph_real* x,
