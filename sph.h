@@ -148,8 +148,9 @@ int main(void) {
    density, the multiphase (or interface) pressure gradient holds layers at rest (see PHASES),
    while SPH_PGRAD_DIFFERENCE lets buoyancy-driven interfaces move as they should (Rayleigh-Taylor
    growth within 7 % of the viscous theory at Atwood 0.5 and 0.29, where the antisymmetric forms
-   grow 3-10 times too slowly, tests/test_rt.c; it fails, reported, on the 10:1 column). Once
-   the interface mixes, that gradient needs def.shifting = 4 (particle shifting, Sun et al.
+   grow 3-10 times too slowly, tests/test_rt.c; for fluid that fills its walls: at a free surface
+   it is refused, sph__check_free_surface). Once the interface mixes, that gradient needs
+   def.shifting = 4 (particle shifting, Sun et al.
    2017; see sph__stage_shift): on He, Chen & Zhang's 1999 Rayleigh-Taylor case (Atwood 0.5,
    Re 256) it fails without it at t sqrt(g/W) = 1.3-2.3 (a particle compressed by 20 %, sooner
    at finer resolution), and with it reaches t sqrt(g/W) = 3: the spike 0.11, 0.07 and 0.04 W
@@ -488,19 +489,19 @@ int main(void) {
    restart the pressure from 0). Not met: staying below 1 % of sqrt(g H) throughout the 10 s.
    After coming to rest (0.2-0.5 % at 4-6 s, 20 across) episodes of 2-3 % follow (a row sliding
    along the floor or along the lower interface), as in a one-phase tank of the same depth and
-   spacing (WCSPH 4.6 %, enhanced PCISPH 3.9 % within 10 s): a property of the walls and
-   solvers, not of the phases. Not for phases of different
-   density: the symmetric gradient, the multiphase gradient with the mass continuity equation (a
-   light particle takes its heavy neighbours' masses), SPH_PGRAD_DIFFERENCE on a 10:1 column (it
-   is for interfaces that should move, see WCSPH), the original PCISPH, IISPH, DFSPH and PBF
-   (summation density, or PBF's constraint on it, smears the mass jump: ratios near 1 only;
-   IISPH and DFSPH refuse rest densities in a ratio below 0.75 with SPH_ERR_ARG: at 0.5 a light
-   blob rising in water gained 0.4-0.6 M g dx in its first second, every frame SPH_OK, and on
-   this column they ran at 2.0-2.4 m/s for 0.5 s before failing). On the column the others fail
-   with SPH_ERR_UNSTABLE from sph_advance (WCSPH symmetric with particle density, multiphase
-   with continuity; the original PCISPH within a few steps, tests/test_pcisph.c),
-   or run without resting: WCSPH symmetric with continuity 7 % and PBF 72 % of sqrt(g H) after
-   0.5 s. None loses a particle silently (tests/test_layers.c checks every frame). Gases and
+   spacing (WCSPH 4.6 %, enhanced PCISPH 3.9 % within 10 s): a property of the walls and solvers,
+   not of the phases. Not for phases of different density: the symmetric gradient, the multiphase
+   gradient with the mass continuity equation (a light particle takes its heavy neighbours'
+   masses), SPH_PGRAD_DIFFERENCE (for interfaces that should move in fluid that fills its walls,
+   see WCSPH; a column with a free surface is refused), the original PCISPH, IISPH, DFSPH and PBF
+   (summation density, or PBF's constraint on it, smears the mass jump: ratios near 1 only; IISPH
+   and DFSPH refuse rest densities in a ratio below 0.75 with SPH_ERR_ARG: at 0.5 a light blob
+   rising in water gained 0.4-0.6 M g dx in its first second, every frame SPH_OK, and on this
+   column they ran at 2.0-2.4 m/s for 0.5 s before failing). On the column the others fail with
+   SPH_ERR_UNSTABLE from sph_advance (WCSPH symmetric with particle density, multiphase with
+   continuity; the original PCISPH within a few steps, tests/test_pcisph.c), or run without
+   resting: WCSPH symmetric with continuity 7 % and PBF 72 % of sqrt(g H) after 0.5 s. None loses a
+   particle silently (tests/test_layers.c checks every frame). Gases and
    1000:1 interfaces: the compressible step (SOLVER: COMPRESSIBLE) with particle density and
    def.pressure_grad = SPH_PGRAD_VOLUME, the momentum equation of the particle density (Hu &
    Adams 2006's (p_i/n_i^2 + p_j/n_j^2) with n = 1/V), a background pressure in both phases and
@@ -867,7 +868,9 @@ typedef enum sph_pressure_grad {
                                 too slowly). Not pairwise antisymmetric: momentum is conserved
                                 only to the discretisation error. WCSPH only (sph_world_init
                                 rejects it for the other solvers: PCISPH's gain and the
-                                compressible step's energy need the antisymmetric forms)       */
+                                compressible step's energy need the antisymmetric forms), for
+                                fluid that fills its walls: a free surface is refused at the
+                                first step (SPH_ERR_ARG, sph__check_free_surface)               */
     SPH_PGRAD_VOLUME         /* 1/m_i sum_j (V_i^2 p_i + V_j^2 p_j) grad W_ij, V = m/rho: the pair
                                 term Hu & Adams 2006 derive with the particle number density
                                 1/V, the momentum equation that goes with Ott & Schnetter's
@@ -950,7 +953,8 @@ typedef enum sph_boundary_volume {
 
 typedef enum sph_wall {
     SPH_WALL_FREE_SLIP = 0, /* no viscous interaction with wall particles (default)             */
-    SPH_WALL_NO_SLIP        /* viscous terms use Adami's extrapolated wall velocity             */
+    SPH_WALL_NO_SLIP        /* viscous terms use Adami's extrapolated wall velocity (not PBF,
+                               whose walls are free slip: SPH_ERR_ARG)                         */
 } sph_wall;
 
 typedef enum sph_pressure_clamp {
@@ -3508,6 +3512,10 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
                "sph_world_def.viscosity_form = %d: not a sph_viscosity_form", (int)d->viscosity_form);
     SPH__CHECK((int)d->wall >= 0 && d->wall <= SPH_WALL_NO_SLIP,
                "sph_world_def.wall = %d: not a sph_wall", (int)d->wall);
+    SPH__CHECK(d->wall != SPH_WALL_NO_SLIP || d->solver != SPH_SOLVER_PBF,
+               "sph_world_def.wall = SPH_WALL_NO_SLIP: PBF's walls are free slip (its viscosity "
+               "and XSPH smooth over fluid neighbours only); choose SPH_WALL_FREE_SLIP or another "
+               "solver");
     SPH__CHECK(sph__finite((double)d->delta) && d->delta >= 0 && d->delta <= 1,
                "sph_world_def.delta = %g: must be in [0, 1]", (double)d->delta);
     SPH__CHECK(sph__finite((double)d->alpha) && d->alpha >= 0 && d->alpha <= 10,
@@ -7705,6 +7713,34 @@ static void sph__rederive_sound_speed(sph_world* w) {
             w->phases[q].sound_speed = old[q];
 }
 
+/* sum_j V_j W(|x - p_j|) over the points p of grid g (built on p) within the kernel's support of
+   x, V_j = vol[j] or, without vol, v0: the kernel sums of the checks before a step, which run
+   before the step's lists exist. *buf (*cap entries, grown as needed) holds a query's result. */
+static sph_status sph__grid_kernel_sum(const sph_world* w, const sph_grid* g, const sph_real* p,
+                                       const sph_real* vol, double v0, const sph_real* x,
+                                       uint32_t** buf, size_t* cap, double* sum) {
+    const size_t D = (size_t)w->dim;
+    size_t m = sph_grid_query(g, p, x, w->kernel.radius, *buf, *cap), q;
+    *sum = 0;
+    if (m > *cap) { /* more neighbours than room: a larger buffer, the query again */
+        uint32_t* more = (uint32_t*)SPH_MALLOC(m * sizeof(uint32_t));
+        if (!more) return SPH_ERR_NOMEM;
+        SPH_FREE(*buf);
+        *buf = more;
+        *cap = m;
+        m = sph_grid_query(g, p, x, w->kernel.radius, *buf, *cap);
+    }
+    for (q = 0; q < m; ++q) {
+        sph_real d[3] = {0, 0, 0}, r2 = 0;
+        size_t k;
+        sph_grid_delta(g, x, p + (size_t)(*buf)[q] * D, d);
+        for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+        *sum += (vol ? (double)vol[(*buf)[q]] : v0) *
+                (double)sph_kernel_w(&w->kernel, (sph_real)sqrt((double)r2));
+    }
+    return SPH_OK;
+}
+
 /* Fluid placed inside walls (check_walls, lattice walls of given volumes): before the first step
    after the host added fluid or walls, a fluid particle whose wall volume fraction
    sum_b V_b W_ib / S lies beyond that of the wall's first layer (sph__wall_fraction_limit; a fill
@@ -7716,43 +7752,22 @@ static void sph__rederive_sound_speed(sph_world* w) {
    grid of their own (sph_grid) and each fluid particle queried, about a neighbour search. */
 static sph_status sph__check_placed(sph_world* w) {
     const size_t D = (size_t)w->dim;
-    const sph_real R = w->kernel.radius;
     sph_grid g;
     uint32_t* buf;
     size_t cap = 256, i, bad = (size_t)-1;
-    double fbad = 0;
+    double fbad = 0, sum = 0;
     sph_status s;
-    if (!w->priv.placed) return SPH_OK;
     if (!w->def.check_walls || w->nb == 0 || w->def.boundary_volume == SPH_BVOL_AKINCI ||
-        !(w->priv.wall_fraction_max > 0) || w->priv.placed_from >= w->n) {
-        w->priv.placed = 0;
+        !(w->priv.wall_fraction_max > 0) || w->priv.placed_from >= w->n)
         return SPH_OK;
-    }
-    s = sph_grid_init(&g, w->dim, R, w->def.periodic, w->def.domain_lo, w->def.domain_hi);
+    s = sph_grid_init(&g, w->dim, w->kernel.radius, w->def.periodic, w->def.domain_lo,
+                      w->def.domain_hi);
     if (s != SPH_OK) return sph__fail(w, s, -1, "step: the walls' grid: %s", sph_status_string(s));
     buf = (uint32_t*)SPH_MALLOC(cap * sizeof(uint32_t));
     s = buf ? sph_grid_build(&g, w->b_x, w->nb) : SPH_ERR_NOMEM;
     for (i = w->priv.placed_from; s == SPH_OK && i < w->n && bad == (size_t)-1; ++i) {
-        const sph_real* xi = w->x + i * D;
-        size_t m = sph_grid_query(&g, w->b_x, xi, R, buf, cap), q;
-        double sum = 0;
-        if (m > cap) { /* more wall neighbours than room: a larger buffer, the query again */
-            uint32_t* more = (uint32_t*)SPH_MALLOC(m * sizeof(uint32_t));
-            if (!more) { s = SPH_ERR_NOMEM; break; }
-            SPH_FREE(buf);
-            buf = more;
-            cap = m;
-            m = sph_grid_query(&g, w->b_x, xi, R, buf, cap);
-        }
-        for (q = 0; q < m; ++q) {
-            sph_real d[3] = {0, 0, 0}, r2 = 0;
-            size_t k;
-            sph_grid_delta(&g, xi, w->b_x + (size_t)buf[q] * D, d);
-            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
-            sum += (double)w->b_vol[buf[q]] *
-                   (double)sph_kernel_w(&w->kernel, (sph_real)sqrt((double)r2));
-        }
-        if (sum / (double)w->priv.lattice_sum > (double)w->priv.wall_fraction_max) {
+        s = sph__grid_kernel_sum(w, &g, w->b_x, w->b_vol, 0, w->x + i * D, &buf, &cap, &sum);
+        if (s == SPH_OK && sum / (double)w->priv.lattice_sum > (double)w->priv.wall_fraction_max) {
             bad = i;
             fbad = sum / (double)w->priv.lattice_sum;
         }
@@ -7770,7 +7785,67 @@ static sph_status sph__check_placed(sph_world* w) {
                          bad, (unsigned)w->id[bad], (double)xb[0], D > 1 ? (double)xb[1] : 0.0,
                          D > 2 ? (double)xb[2] : 0.0, fbad, (double)w->priv.wall_fraction_max);
     }
-    w->priv.placed = 0;
+    return SPH_OK;
+}
+
+/* SPH_PGRAD_DIFFERENCE's force sum_j V_j (p_j - p_i) grad W_ij takes no pressure from where no
+   neighbour is: at a free surface it misses the zero pressure of the empty side, which the
+   antisymmetric forms bring in through p_i sum_j V_j grad W_ij, so the rows under a surface feel
+   too little of the hydrostatic gradient and sink. Measured (a 2D tank at rest, 0.5 m wide, 15
+   particles deep, sph_advance with WCSPH's defaults but this gradient): 1.4 m/s and 22 %
+   compression after 0.05 s, every frame SPH_OK, then a failure at 0.13 s. So the first step after
+   fluid or walls are added refuses a world with this gradient in which a fluid particle's kernel
+   sum sum_j V_j W_ij / S (V = dx^dim for fluid and walls alike: a count of neighbours, so a single
+   wall layer counts as it weighs in a thick wall) is below SPH__SURFACE_SUM. Measured on that tank
+   (Wendland C2, h = 1.3 dx) in 2D and 3D: the lattice's top row 0.79 (0.83-0.87 where it meets the
+   side walls), the row under it and the rest 0.995-1.0; a single wall layer one spacing away
+   stands in for the missing row (+0.21). */
+#define SPH__SURFACE_SUM 0.9
+static sph_status sph__check_free_surface(sph_world* w) {
+    const size_t D = (size_t)w->dim;
+    double vdx = 1, sum = 0, sb = 0;
+    sph_grid gf, gb;
+    uint32_t* buf;
+    size_t cap = 256, i, bad = (size_t)-1;
+    sph_status s, sg;
+    int k;
+    if (w->def.pressure_grad != SPH_PGRAD_DIFFERENCE || w->n == 0) return SPH_OK;
+    for (k = 0; k < w->dim; ++k) vdx *= (double)w->dx;
+    s = sph_grid_init(&gf, w->dim, w->kernel.radius, w->def.periodic, w->def.domain_lo,
+                      w->def.domain_hi);
+    sg = sph_grid_init(&gb, w->dim, w->kernel.radius, w->def.periodic, w->def.domain_lo,
+                       w->def.domain_hi);
+    if (s != SPH_OK || sg != SPH_OK)
+        return sph__fail(w, SPH_ERR_NOMEM, -1, "step: the free-surface check's grids");
+    buf = (uint32_t*)SPH_MALLOC(cap * sizeof(uint32_t));
+    s = buf ? sph_grid_build(&gf, w->x, w->n) : SPH_ERR_NOMEM;
+    if (s == SPH_OK && w->nb > 0) s = sph_grid_build(&gb, w->b_x, w->nb);
+    for (i = 0; s == SPH_OK && i < w->n && bad == (size_t)-1; ++i) {
+        const sph_real* xi = w->x + i * D;
+        s = sph__grid_kernel_sum(w, &gf, w->x, NULL, vdx, xi, &buf, &cap, &sum);
+        if (s == SPH_OK && w->nb > 0)
+            s = sph__grid_kernel_sum(w, &gb, w->b_x, NULL, vdx, xi, &buf, &cap, &sb);
+        if (s == SPH_OK && (sum + sb) / (double)w->priv.lattice_sum < SPH__SURFACE_SUM) {
+            bad = i;
+            sum = (sum + sb) / (double)w->priv.lattice_sum;
+        }
+        sb = 0;
+    }
+    SPH_FREE(buf);
+    sph_grid_free(&gf);
+    sph_grid_free(&gb);
+    if (s != SPH_OK) return sph__fail(w, s, -1, "step: out of memory (the free-surface check)");
+    if (bad != (size_t)-1) {
+        const sph_real* xb = w->x + bad * D;
+        return sph__fail(w, SPH_ERR_ARG, (long)bad,
+                         "def.pressure_grad = SPH_PGRAD_DIFFERENCE needs fluid that fills its "
+                         "walls and periodic directions, but fluid particle %zu (id %u) at (%g, "
+                         "%g, %g) has a free surface (kernel sum %g of a full neighbourhood): "
+                         "there the difference form misses the empty side's zero pressure and "
+                         "the surface rows sink; use SPH_PGRAD_MULTIPHASE or the default",
+                         bad, (unsigned)w->id[bad], (double)xb[0], D > 1 ? (double)xb[1] : 0.0,
+                         D > 2 ? (double)xb[2] : 0.0, sum);
+    }
     return SPH_OK;
 }
 
@@ -7794,6 +7869,15 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
                                  "internal energy only sph_step_compressible evolves", k);
     s = sph__check_def_now(w);
     if (s != SPH_OK) return s;
+    /* sph_world_init checks these against def.solver; a host may call another sph_step_* */
+    if (solver == SPH_SOLVER_PBF && w->def.wall == SPH_WALL_NO_SLIP)
+        return sph__fail(w, SPH_ERR_ARG, -1,
+                         "sph_step_pbf: def.wall = SPH_WALL_NO_SLIP, but PBF's walls are free "
+                         "slip (its viscosity and XSPH smooth over fluid neighbours only)");
+    if (solver != SPH_SOLVER_WCSPH && w->def.pressure_grad == SPH_PGRAD_DIFFERENCE)
+        return sph__fail(w, SPH_ERR_ARG, -1,
+                         "step: def.pressure_grad = SPH_PGRAD_DIFFERENCE is for WCSPH only "
+                         "(solver %d)", (int)solver);
     if ((solver == SPH_SOLVER_IISPH || solver == SPH_SOLVER_DFSPH) &&
         sph__rest_density_ratio(w) < SPH__SUMMED_RATIO_MIN)
         return sph__fail(w, SPH_ERR_ARG, -1,
@@ -7806,8 +7890,12 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
                          solver == SPH_SOLVER_IISPH ? "IISPH" : "DFSPH");
     s = sph__check_step_input(w, dt);
     if (s != SPH_OK) return s;
-    s = sph__check_placed(w);
-    if (s != SPH_OK) return s;
+    if (w->priv.placed) { /* fluid or walls added since the last step */
+        s = sph__check_placed(w);
+        if (s == SPH_OK) s = sph__check_free_surface(w);
+        if (s != SPH_OK) return s;
+        w->priv.placed = 0;
+    }
     if (w->priv.placed_c0) {
         sph__rederive_sound_speed(w);
         w->priv.placed_c0 = 0;

@@ -319,24 +319,40 @@ static void test_determinism(void) {
 
 /* ---- bad input -------------------------------------------------------------------------------- */
 
+/* Each bad field is named; PBF's walls are free slip, so SPH_WALL_NO_SLIP (which it would
+   ignore) is refused, also when a host calls sph_step_pbf on a world defined for another solver
+   (the world is left as it was). */
 static void test_bad_def(void) {
     int q;
-    for (q = 0; q < 5; ++q) {
-        sph_world_def def = sph_world_def_default(2);
-        sph_world w;
+    sph_world_def def = sph_world_def_default(2);
+    sph_world w;
+    for (q = 0; q < 6; ++q) {
         const char* field = "";
+        def = sph_world_def_default(2);
         def.solver = SPH_SOLVER_PBF;
         switch (q) {
         case 0: def.pbf_iterations = 0; field = "pbf_iterations"; break;
         case 1: def.pbf_relaxation = 0; field = "pbf_relaxation"; break;
         case 2: def.pbf_scorr = (sph_real)-0.1; field = "pbf_scorr"; break;
         case 3: def.pbf_xsph = (sph_real)0.6; field = "pbf_xsph"; break;
+        case 4: def.wall = SPH_WALL_NO_SLIP; field = "NO_SLIP"; break;
         default: def.pbf_compression = 0; field = "pbf_compression"; break;
         }
         CHECK_EQ_INT(sph_world_init(&w, &def), SPH_ERR_ARG);
         CHECK_MSG(strstr(w.error, field) != NULL, "%s: %s", field, w.error);
         sph_world_free(&w);
     }
+    def = sph_world_def_default(2);
+    def.wall = SPH_WALL_NO_SLIP; /* WCSPH's world, stepped by PBF */
+    if (pbf_block(&w, def, 10, 10, 0.02) == SPH_OK) {
+        const uint64_t h0 = th_state_hash(&w);
+        CHECK_EQ_INT(sph_step_pbf(&w, (sph_real)1e-3), SPH_ERR_ARG);
+        CHECK_MSG(strstr(w.error, "NO_SLIP") != NULL, "%s", w.error);
+        CHECK(th_state_hash(&w) == h0 && w.steps == 0);
+    } else {
+        CHECK_MSG(0, "setup: %s", w.error);
+    }
+    sph_world_free(&w);
 }
 
 const th_test tests_pbf[] = {{"pbf/projection", test_projection},
