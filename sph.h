@@ -150,11 +150,11 @@ int main(void) {
    growth within 7 % of the viscous theory at Atwood 0.5 and 0.29, where the antisymmetric forms
    grow 3-10 times too slowly, tests/test_rt.c; for fluid that fills its walls: at a free surface
    it is refused, sph__check_free_surface). Once the interface mixes, that gradient needs
-   def.shifting = 4 (particle shifting, Sun et al.
-   2017; see sph__stage_shift): on He, Chen & Zhang's 1999 Rayleigh-Taylor case (Atwood 0.5,
-   Re 256) it fails without it at t sqrt(g/W) = 1.3-2.3 (a particle compressed by 20 %, sooner
-   at finer resolution), and with it reaches t sqrt(g/W) = 3: the spike 0.11, 0.07 and 0.04 W
-   behind their position at 32, 64 and 128 particles across W, the bubble within 0.04 W. delta-SPH
+   def.shifting = 4 (particle shifting, Sun et al. 2017; see sph__stage_shift): on He, Chen &
+   Zhang's 1999 Rayleigh-Taylor case (Atwood 0.5, Re 256) it fails without it at t sqrt(g/W) =
+   1.3-2.3 (a particle compressed by 20 %, sooner at finer resolution), and with it reaches t
+   sqrt(g/W) = 3: the spike 0.11, 0.07 and 0.04 W behind their position at 32, 64 and 128 particles
+   across W, the bubble within 0.04 W. delta-SPH
    diffuses pressure, not rho/rho0, across a phase interface. Viscosity: Monaghan's
    artificial viscosity (alpha = 0.02 by default) and a laminar viscosity per phase (Morris et al.
    1997 by default, or the 2(d+2) form of Enhanced PCISPH 2018 eq. 2.5); see VISCOSITY below
