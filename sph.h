@@ -1149,8 +1149,11 @@ typedef struct sph_world_def {
                                   PCISPH, IISPH, DFSPH and PBF (ten times the free-fall speed
                                   over the height the fluid can fall, or the fastest start,
                                   with the automatic c0; the jets of impacts grow with the
-                                  resolution and can pass it: raise it there); no check while
-                                  no c0 is set; >= 0                                           */
+                                  resolution and can pass it: raise it there), for them plus
+                                  what a fall below the fluid's start gives: v^2 <= bound^2 +
+                                  2 (head - (-g.x)), head the largest -g.x + v^2/2 at the first
+                                  step since the host changed the state; no check while no c0
+                                  is set; >= 0                                                 */
     sph_real max_displacement; /* blow-up if a fluid particle moves more than this many spacings
                                   dx in one step [-] (a large step through a thin wall, or a
                                   runaway); default 1; 0 = no check; >= 0                        */
@@ -1376,6 +1379,11 @@ typedef struct sph__private {
     uint8_t* b_thin;                /* [nb] 3D incompressible solvers: 1 for a wall particle of a
                                        thin wall (sph__wall_thin), else 0                        */
     int b_thin_on;                  /* b_thin holds the walls' present order                    */
+    double head_ref;                /* the largest specific mechanical energy -g.x + v^2/2 of a
+                                       fluid particle at the end of the first step since the host
+                                       last changed the state [J/kg] (the speed bound's headroom
+                                       for a fall, sph__integrate_with)                          */
+    int head_ref_on;                /* head_ref is set                                          */
     sph_real wall_fraction_max;     /* check_walls: wall volume fraction of a particle on the
                                        first layer of a flat lattice wall                          */
     uint8_t c0_auto[SPH_MAX_PHASES]; /* the phase's sound speed was derived (sph_phase)      */
@@ -6622,8 +6630,10 @@ static sph_status sph__check_step_input(sph_world* w, sph_real dt) {
            step: the energy check starts again from here (a rounding-level difference is the
            order of the sums) */
         if (!bad && (!(fabs(ke - w->stats.kinetic_energy) <= 1e-9 * (ke + w->stats.kinetic_energy)) ||
-                     !(fabs(pe - w->stats.potential_energy) <= 1e-9 * pa)))
+                     !(fabs(pe - w->stats.potential_energy) <= 1e-9 * pa))) {
             w->stats.unforced_steps = 0;
+            w->priv.head_ref_on = 0; /* the fall's headroom too (sph__integrate_with) */
+        }
     }
     for (; i < w->n; ++i) {
         for (k = 0; k < D; ++k) {
@@ -6693,8 +6703,8 @@ static sph_status sph__boundary_motion(sph_world* w, double t) {
    `final`, also the step's diagnostics and blow-up detection. Reductions run over fixed blocks
    combined in block order, so the result does not depend on the number of threads. */
 enum { SPH__RED_KE, SPH__RED_ERRSUM, SPH__RED_ERRMAX, SPH__RED_COMP, SPH__RED_V2MAX,
-       SPH__RED_A2MAX, SPH__RED_OUT, SPH__RED_CONTACT, SPH__RED_WREL, SPH__RED_PE, SPH__RED_BAD,
-       SPH__RED_KIND, SPH__RED_N };
+       SPH__RED_A2MAX, SPH__RED_OUT, SPH__RED_CONTACT, SPH__RED_WREL, SPH__RED_PE, SPH__RED_HEAD,
+       SPH__RED_BAD, SPH__RED_KIND, SPH__RED_N };
 enum { SPH__BAD_NONE, SPH__BAD_NONFINITE, SPH__BAD_DENSITY, SPH__BAD_COMPRESSION, SPH__BAD_SPEED,
        SPH__BAD_ENERGY, SPH__BAD_DISPLACEMENT, SPH__BAD_WALL, SPH__BAD_TANK };
 
@@ -7139,6 +7149,10 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
     const int D = w->dim;
     const size_t nblk = (w->n + SPH__BLOCK - 1) / SPH__BLOCK;
     sph_real vlim = w->def.max_speed;
+    /* the automatic bound's headroom for a fall: below, with the bound */
+    const int fall = !(w->def.max_speed > 0) && sph__incompressible(w->priv.solver) &&
+                     w->priv.head_ref_on;
+    const double head_ref = w->priv.head_ref;
     double red[SPH__RED_N];
     /* the largest distance a particle may cover in one step at its final speed [m], and the
        wall fraction check_walls allows (lattice walls of given volumes only) */
@@ -7192,7 +7206,13 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
            of 320 particles, tests/fuzz_corpus/regressions/api/speed-bound-grind.bin: 50 s under
            the sanitizers against 0.06 s); with c0 that input now takes 0.08 s under ASan +
            UBSan (its sph_advance stops at def.max_substeps). Walls move the fluid at up to
-           twice their speed (a piston's reflected wave), which is added */
+           twice their speed (a piston's reflected wave), which is added. A fall adds what gravity
+           gives: particle i may be as fast as v^2 <= vlim^2 + 2 (head_ref - phi_i), phi_i =
+           -g.x_i, head_ref the largest -g.x + v^2/2 of a particle at the end of the first step
+           since the host last changed the state (set below, cleared by sph__check_step_input),
+           so that a runaway's own gain does not raise it. Without it a blob falling freely (no
+           floor below: c0 from its own height) tripped the bound after about 100 of its
+           heights. */
         if (sph__incompressible(w->priv.solver) && vlim > 0) {
             double vb2 = 0;
             size_t b;
@@ -7221,11 +7241,12 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
         int kk;
         for (kk = 0; kk < SPH__RED_N; ++kk) r[kk] = 0;
         r[SPH__RED_BAD] = -1;
+        r[SPH__RED_HEAD] = -1e300;
         for (i = i0; i < i1; ++i) {
             sph_real* xi = w->x + i * (size_t)D;
             sph_real* vi = w->v + i * (size_t)D;
             const sph_real* ai = acc + i * (size_t)D;
-            double v2 = 0, a2 = 0, err, mi;
+            double v2 = 0, a2 = 0, err, mi, phi = 0;
             int out = 0, bad = SPH__BAD_NONE;
             sph_real xold[3], gold[3];
             int guard = 0;
@@ -7278,6 +7299,7 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 for (kk = 0; kk < D; ++kk) sh[i * (size_t)D + (size_t)kk] = xi[kk] - sh[i * (size_t)D + (size_t)kk];
             mi = (double)(w->m ? w->m[i] : w->mass);
             for (kk = 0; kk < D; ++kk) {
+                if (!c->per[kk]) phi -= (double)c->g[kk] * (double)xi[kk];
                 v2 += (double)vi[kk] * (double)vi[kk];
                 a2 += (double)ai[kk] * (double)ai[kk];
                 if (!sph__finite((double)xi[kk])) bad = SPH__BAD_NONFINITE;
@@ -7296,15 +7318,17 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 bad = SPH__BAD_ENERGY;
             else if (cmax > 0 && err > cmax && !c->pc[w->phase[i]].gas)
                 bad = SPH__BAD_COMPRESSION;
-            else if (vlim > 0 && v2 > (double)vlim * (double)vlim) bad = SPH__BAD_SPEED;
+            else if (vlim > 0 && v2 > (double)vlim * (double)vlim +
+                                          (fall && head_ref > phi ? 2 * (head_ref - phi) : 0))
+                bad = SPH__BAD_SPEED;
             else if (dmax > 0 && v2 * dt2 > dmax * dmax) bad = SPH__BAD_DISPLACEMENT;
             else if (walls && c->fb->count[i] > 0 &&
                      sph__wall_fraction(c, xi, i, w->priv.lattice_sum) > w->priv.wall_fraction_max)
                 bad = SPH__BAD_WALL;
             else if (tank && sph__tank_outside(w, xi)) bad = SPH__BAD_TANK;
             r[SPH__RED_KE] += 0.5 * mi * v2;
-            for (kk = 0; kk < D; ++kk)
-                if (!c->per[kk]) r[SPH__RED_PE] -= mi * (double)c->g[kk] * (double)xi[kk];
+            r[SPH__RED_PE] += mi * phi;
+            if (phi + 0.5 * v2 > r[SPH__RED_HEAD]) r[SPH__RED_HEAD] = phi + 0.5 * v2;
             if (err > 0 && w->p && w->rho[i] > 0)
                 r[SPH__RED_WREL] += (double)w->p[i] * mi / (double)w->rho[i] * err;
             r[SPH__RED_ERRSUM] += fabs(err);
@@ -7323,6 +7347,7 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
     if (!final) return SPH_OK;
     for (k = 0; k < SPH__RED_N; ++k) red[k] = 0;
     red[SPH__RED_BAD] = -1;
+    red[SPH__RED_HEAD] = -1e300;
     for (q = 0; q < nblk; ++q) {
         const double* r = w->priv.block + q * SPH__RED_N;
         red[SPH__RED_KE] += r[SPH__RED_KE];
@@ -7335,6 +7360,7 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
         red[SPH__RED_CONTACT] += r[SPH__RED_CONTACT];
         red[SPH__RED_WREL] += r[SPH__RED_WREL];
         red[SPH__RED_PE] += r[SPH__RED_PE];
+        if (r[SPH__RED_HEAD] > red[SPH__RED_HEAD]) red[SPH__RED_HEAD] = r[SPH__RED_HEAD];
         if (red[SPH__RED_BAD] < 0 && r[SPH__RED_BAD] >= 0) {
             red[SPH__RED_BAD] = r[SPH__RED_BAD];
             red[SPH__RED_KIND] = r[SPH__RED_KIND];
@@ -7355,6 +7381,10 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
     }
     w->stats.kinetic_energy = red[SPH__RED_KE];
     w->stats.potential_energy = red[SPH__RED_PE];
+    if (!w->priv.head_ref_on && w->n > 0) {
+        w->priv.head_ref = red[SPH__RED_HEAD];
+        w->priv.head_ref_on = 1;
+    }
     w->stats.density_error_avg = w->n ? red[SPH__RED_ERRSUM] / (double)w->n : 0;
     w->stats.density_error_max = red[SPH__RED_ERRMAX];
     w->stats.compression_avg = w->n ? red[SPH__RED_COMP] / (double)w->n : 0;
