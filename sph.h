@@ -7849,8 +7849,12 @@ static sph_status sph__check_free_surface(sph_world* w) {
                       w->def.domain_hi);
     sg = sph_grid_init(&gb, w->dim, w->kernel.radius, w->def.periodic, w->def.domain_lo,
                        w->def.domain_hi);
-    if (s != SPH_OK || sg != SPH_OK)
-        return sph__fail(w, SPH_ERR_NOMEM, -1, "step: the free-surface check's grids");
+    if (s != SPH_OK || sg != SPH_OK) {
+        if (s == SPH_OK) sph_grid_free(&gf);
+        if (sg == SPH_OK) sph_grid_free(&gb);
+        s = s != SPH_OK ? s : sg;
+        return sph__fail(w, s, -1, "step: the free-surface check's grid: %s", sph_status_string(s));
+    }
     buf = (uint32_t*)SPH_MALLOC(cap * sizeof(uint32_t));
     s = buf ? sph_grid_build(&gf, w->x, w->n) : SPH_ERR_NOMEM;
     if (s == SPH_OK && w->nb > 0) s = sph_grid_build(&gb, w->b_x, w->nb);
