@@ -1335,8 +1335,6 @@ typedef struct sph__private {
     size_t shift_cap;
     sph_real *xp, *vp;              /* PCISPH: predicted positions and velocities (scratch)         */
     size_t xp_cap, vp_cap;
-    sph_real* xs;                   /* PBF: the predicted positions x* through the projections  */
-    size_t xs_cap;
     sph_real *de, *cs, *vn;         /* compressible: energy rate, sound speed, v at the step start  */
     size_t de_cap, cs_cap, vn_cap;
     sph_real* soc;                  /* second-order scheme: its per-particle scratch                */
@@ -3865,7 +3863,6 @@ SPHDEF void sph_world_free(sph_world* w) {
     SPH_FREE(w->priv.vol);
     SPH_FREE(w->priv.shift);
     SPH_FREE(w->priv.xp);
-    SPH_FREE(w->priv.xs);
     SPH_FREE(w->priv.vp);
     SPH_FREE(w->priv.de);
     SPH_FREE(w->priv.cs);
@@ -4646,7 +4643,7 @@ SPHDEF size_t sph_world_memory(const sph_world* w) {
               w->priv.df_kv_cap + w->priv.df_pv_cap +
               w->priv.ff_fw_cap + w->priv.fb_fw_cap + w->priv.pr2_cap + w->priv.vol_cap +
               w->priv.shift_cap +
-              w->priv.xp_cap + w->priv.xs_cap +
+              w->priv.xp_cap +
               w->priv.vp_cap + w->priv.de_cap + w->priv.cs_cap + w->priv.vn_cap + w->priv.bpq_cap + w->priv.soc_cap + w->priv.socw_cap +
               w->priv.lapc_cap + w->priv.wg_cap + w->priv.abody_cap) *
                  sizeof(sph_real);
@@ -5234,7 +5231,6 @@ static sph_status sph__scratch(sph_world* w, sph_real** p, size_t count) {
                   : p == &w->priv.vol   ? &w->priv.vol_cap
                   : p == &w->priv.shift ? &w->priv.shift_cap
                   : p == &w->priv.xp    ? &w->priv.xp_cap
-                  : p == &w->priv.xs    ? &w->priv.xs_cap
                   : p == &w->priv.vp    ? &w->priv.vp_cap
                   : p == &w->priv.de    ? &w->priv.de_cap
                   : p == &w->priv.cs    ? &w->priv.cs_cap
@@ -10247,20 +10243,15 @@ static void sph__pbf_begin(sph_world* w, sph_real dt, uint64_t sorts) {
     }
 }
 
-/* Line 21: v = (x_proj - x^n) / dt, as v* + (x_proj - x*) / dt (x* = x^n + dt v*: the same in
-   exact arithmetic): from the difference of positions a step apart, float lost gravity's
-   increment g dt^2 wherever it was below a position's rounding (a block falling freely 31 m,
-   dx 0.02: its centre of mass at 22.6 m/s instead of g t = 24.5 after 2.5 s, at the 0.2 ms
-   steps of its speed; tests/test_reliability.c, free_fall_not_a_runaway); the projection's
-   correction x_proj - x* is what is left to round. Then line 22 (XSPH, viscosity) through
-   scratch `vo`, and w->a = (v^{n+1} - v^n) / dt for the diagnostics. */
+/* Line 21: v = (x_proj - x^n) / dt; then line 22 (XSPH, viscosity) through scratch `vo`, and
+   w->a = (v^{n+1} - v^n) / dt for the diagnostics. */
 static void sph__pbf_velocity(sph_world* w, const sph__ctx* c, sph__pbf* P, const sph_real* xproj,
                               sph_real* vo, sph_real dt) {
     const size_t nD = w->n * (size_t)w->dim;
     sph__idx i;
     SPH__OMP_FOR(nD)
     for (i = 0; i < (sph__idx)nD; ++i) {
-        const sph_real v = w->v[i] + (xproj[i] - w->priv.xs[i]) / dt;
+        const sph_real v = (xproj[i] - w->x[i]) / dt;
         w->a[i] = w->priv.ap[i] - w->v[i] / dt; /* a_ext - v* / dt, completed below */
         w->v[i] = v;
     }
@@ -10284,8 +10275,7 @@ static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
     if ((s = sph__scratch(w, &w->priv.xp, w->capacity * (size_t)w->dim)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.vp, w->capacity * (size_t)w->dim)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.ap, w->capacity * (size_t)w->dim)) != SPH_OK ||
-        (s = sph__scratch(w, &w->priv.src, w->capacity)) != SPH_OK ||
-        (s = sph__scratch(w, &w->priv.xs, w->capacity * (size_t)w->dim)) != SPH_OK)
+        (s = sph__scratch(w, &w->priv.src, w->capacity)) != SPH_OK)
         return s;
     /* walls where the projection moves the particles to: at the step's end */
     s = sph__boundary_motion(w, w->time + (double)dt);
@@ -10308,7 +10298,6 @@ static sph_status sph__step_pbf(sph_world* w, sph_real dt) {
     }
     sph__pbf_setup(w, &c, &P, dt);
     sph__pbf_begin(w, dt, sorts);
-    sph__copy(w->priv.xs, w->priv.xp, w->n * (size_t)w->dim * sizeof(sph_real)); /* x* */
     sph__time(w, SPH_STAGE_NEIGHBORS, &t0);
     /* project (lines 8-19): Jacobi, two passes each, between the buffers xp and vp */
     xa = w->priv.xp;
