@@ -350,7 +350,8 @@ int main(void) {
    walls are added: lattice walls of several layers keep their given volumes, a layer a host
    samples weighs as a full wall (with dx^dim it weighs too little where its particles are
    sparse: a 2D drum of one layer failed within 0.05 s under IISPH, a 3D one let particles out
-   unreported).
+   unreported); a wall particle with another closer than 0.7 dx (walls sampled denser than the
+   fluid) takes Akinci's alone, or dx^dim each would weigh the wall twice or more.
    Wall contact (def.wall_contact, on by default): no pressure scheme stops a particle that is
    short of fluid neighbours (a splash, the one-particle sheet a dam break spreads along the floor)
    from sinking until the wall supplies the volume it lacks, i.e. onto and past the wall's first
@@ -948,7 +949,8 @@ typedef enum sph_boundary_volume {
                            (default): a lattice wall of several layers keeps its given volumes
                            bit for bit within the fluid's reach (Akinci's are smaller there:
                            0.59-0.74 dx^dim), a wall a host samples as one layer weighs as a
-                           full wall (see sph__stage_boundary_volume_auto)                    */
+                           full wall; Akinci's alone where walls are sampled denser than 0.7
+                           dx (see sph__stage_boundary_volume_auto)                           */
 } sph_boundary_volume;
 
 typedef enum sph_wall {
@@ -1335,6 +1337,13 @@ typedef struct sph__private {
     size_t shift_cap;
     sph_real *xp, *vp;              /* PCISPH: predicted positions and velocities (scratch)         */
     size_t xp_cap, vp_cap;
+    sph_real* xs;                   /* PCISPH with two drifts: x^n (scratch)                      */
+    size_t xs_cap;
+    const sph_real* x_start;        /* a step of two drifts: x^n (xp or xs) for the final drift's
+                                       crossing check (sph__wall_crossed), in the particle order
+                                       of x_start_sorts; NULL for steps of one drift            */
+    uint64_t x_start_sorts;
+    sph_real x_start_drift;         /* the time the first drift covered [s]                     */
     sph_real *de, *cs, *vn;         /* compressible: energy rate, sound speed, v at the step start  */
     size_t de_cap, cs_cap, vn_cap;
     sph_real* soc;                  /* second-order scheme: its per-particle scratch                */
@@ -3699,7 +3708,7 @@ static void sph__contact_ramp(sph_world* w) {
     { /* sph__wall_thin: a lattice plane's kernel sum and a half space's (the plane included) */
         double plane = 0, half = 0;
         for (i = -M; i <= M; ++i)
-            for (k = -M; k <= M; ++k)
+            for (k = (w->dim > 2 ? -M : 0); k <= (w->dim > 2 ? M : 0); ++k)
                 for (j = -M; j <= 0; ++j) {
                     const double q = sqrt((double)(i * i + j * j + k * k)) * (double)w->dx /
                                      (double)w->kernel.h;
@@ -3864,6 +3873,7 @@ SPHDEF void sph_world_free(sph_world* w) {
     SPH_FREE(w->priv.shift);
     SPH_FREE(w->priv.xp);
     SPH_FREE(w->priv.vp);
+    SPH_FREE(w->priv.xs);
     SPH_FREE(w->priv.de);
     SPH_FREE(w->priv.cs);
     SPH_FREE(w->priv.vn);
@@ -4643,7 +4653,7 @@ SPHDEF size_t sph_world_memory(const sph_world* w) {
               w->priv.df_kv_cap + w->priv.df_pv_cap +
               w->priv.ff_fw_cap + w->priv.fb_fw_cap + w->priv.pr2_cap + w->priv.vol_cap +
               w->priv.shift_cap +
-              w->priv.xp_cap +
+              w->priv.xp_cap + w->priv.xs_cap +
               w->priv.vp_cap + w->priv.de_cap + w->priv.cs_cap + w->priv.vn_cap + w->priv.bpq_cap + w->priv.soc_cap + w->priv.socw_cap +
               w->priv.lapc_cap + w->priv.wg_cap + w->priv.abody_cap) *
                  sizeof(sph_real);
@@ -5231,6 +5241,7 @@ static sph_status sph__scratch(sph_world* w, sph_real** p, size_t count) {
                   : p == &w->priv.vol   ? &w->priv.vol_cap
                   : p == &w->priv.shift ? &w->priv.shift_cap
                   : p == &w->priv.xp    ? &w->priv.xp_cap
+                  : p == &w->priv.xs    ? &w->priv.xs_cap
                   : p == &w->priv.vp    ? &w->priv.vp_cap
                   : p == &w->priv.de    ? &w->priv.de_cap
                   : p == &w->priv.cs    ? &w->priv.cs_cap
@@ -5306,10 +5317,12 @@ static sph_status sph__wall_lists(sph_world* w, sph_real radius) {
     return SPH_OK;
 }
 
-/* sum_b' W_bb' / norm_w over wall particle b's wall neighbours, b itself included. */
-static sph_real sph__wall_kernel_sum(const sph_world* w, size_t b) {
+/* sum_b' W_bb' / norm_w over wall particle b's wall neighbours, b itself included; with
+   `once`, a neighbour closer than half a spacing (the same point sampled twice) is left out. */
+static sph_real sph__wall_kernel_sum_of(const sph_world* w, size_t b, int once) {
     const int D = w->dim;
     const sph_neighbors* nl = &w->priv.bb;
+    const sph_real near2 = once ? SPH__R(0.25) * w->dx * w->dx : 0;
     size_t kk, k0 = nl->begin[b], k1 = k0 + nl->count[b];
     sph_real sum = sph__kw(w->kernel.form, 0);
     for (kk = k0; kk < k1; ++kk) {
@@ -5318,9 +5331,13 @@ static sph_real sph__wall_kernel_sum(const sph_world* w, size_t b) {
         int k;
         sph_grid_delta(&w->priv.bgrid, w->b_x + b * (size_t)D, w->b_x + q * (size_t)D, d);
         for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+        if (r2 < near2) continue;
         sum += sph__kw(w->kernel.form, sph__sqrt(r2) * w->kernel.inv_h);
     }
     return sum;
+}
+static sph_real sph__wall_kernel_sum(const sph_world* w, size_t b) {
+    return sph__wall_kernel_sum_of(w, b, 0);
 }
 
 /* Akinci et al. 2012 (Meiers 2025 eq. 27): a wall particle's volume is gamma_1 over its number
@@ -5354,15 +5371,42 @@ static void sph__stage_boundary_volume(sph_world* w) {
    its neighbours. Measured on drums of one layer (R 0.3 m, a third full, at rest or turning at
    2 rad/s): in 2D (dx 0.02) IISPH, DFSPH, both PCISPH and WCSPH failed within 0.05-1.95 s
    (compressed by 20 %, reported); in 3D (dx 0.04) IISPH, DFSPH and PBF let a particle out
-   within 0.35-0.4 s, unreported. The max is idempotent (volumes computed again after a load or
-   a re-sort stay as they were); walls a callback moves keep the volumes of their positions when
-   added (a rigid motion keeps them right; walls that deform want SPH_BVOL_AKINCI). */
+   within 0.35-0.4 s, unreported. A wall particle with another closer than 0.7 dx (a host's
+   sampling denser than the fluid's, or the same point twice where two faces meet) takes
+   Akinci's volume alone: there dx^dim, the default, counts the wall's volume more than once (a
+   one-layer line at 0.5 dx: Akinci 0.51 dx^2 each, the max 1 dx^2). Between 0.7 and 1 dx the
+   max stays: with 0.9 dx the one-layer sphere of sph__wall_crossed's measurement (a host's
+   sampling at about dx) took Akinci's volumes and the original PCISPH's run let a particle into
+   it at 0.90 s; walls 0.75 dx apart still weigh too much (README, Limits). Measured: a 2D tank at rest
+   (0.6 x 0.3 m of water, dx 0.02) in walls of one layer 0.5 dx apart, default volumes, jumped at
+   the first step, and its energy rose 0.935 (IISPH), 0.927 (DFSPH) and 0.041 (PBF) of
+   rho g H^2 W within 0.5 s, every frame SPH_OK; now it never rises
+   (tests/test_reliability.c, dense_host_walls). A lattice
+   at dx (sph_add_wall_box) has no such pair. Both rules are idempotent (volumes computed again
+   after a load or a re-sort stay as they were); walls a callback moves keep the volumes of their
+   positions when added (a rigid motion keeps them right; walls that deform want
+   SPH_BVOL_AKINCI). */
+static int sph__wall_dense(const sph_world* w, size_t b) {
+    const int D = w->dim;
+    const sph_neighbors* nl = &w->priv.bb;
+    const size_t k0 = nl->begin[b], k1 = k0 + nl->count[b];
+    const sph_real lim2 = SPH__R(0.49) * w->dx * w->dx;
+    size_t kk;
+    for (kk = k0; kk < k1; ++kk) {
+        sph_real d[3] = {0, 0, 0}, r2 = 0;
+        int k;
+        sph_grid_delta(&w->priv.bgrid, w->b_x + b * (size_t)D, w->b_x + nl->idx[kk] * (size_t)D, d);
+        for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+        if (r2 < lim2) return 1;
+    }
+    return 0;
+}
 static void sph__stage_boundary_volume_auto(sph_world* w) {
     sph__idx b;
     SPH__OMP_FOR(w->nb)
     for (b = 0; b < (sph__idx)w->nb; ++b) {
         const sph_real va = sph__akinci_volume(w, (size_t)b);
-        if (va > w->b_vol[b]) w->b_vol[b] = va;
+        if (va > w->b_vol[b] || sph__wall_dense(w, (size_t)b)) w->b_vol[b] = va;
     }
 }
 
@@ -5377,16 +5421,20 @@ static void sph__stage_boundary_volume_auto(sph_world* w) {
    (Wendland C2) or 0.82 (cubic) of dx^3, and its corners 0.59 or 0.70 (a 3D box of
    sph_add_wall_box, dx 0.02): with the ramp there the original PCISPH sank a particle through
    the first layer at the corner of a 3D box of sph_add_wall_box (dx 0.04, at 0.16 s, reported
-   by the tank check); as thin walls it holds. Static walls: once; moved walls: at every sort
-   (a rigid motion keeps the flags). Only where the ramp may apply (3D, the incompressible
-   solvers). */
+   by the tank check); as thin walls it holds. The crossing check (sph__wall_crossed) looks at
+   thin walls only, in 2D and 3D and with every solver. A point sampled twice (two wall
+   particles closer than half a spacing: where two faces a host sampled separately meet) counts
+   once in the sum: counted twice, the corner of a box of single layers 1.5 dx apart was not
+   thin, and PBF let 2 of 400 particles out through the hole it left in the check
+   (tests/test_reliability.c, coarse_host_walls). Static walls: once; moved walls: at every
+   sort (a rigid motion keeps the flags). */
 static void sph__wall_thin(sph_world* w) {
     const int akinci = w->def.boundary_volume == SPH_BVOL_AKINCI;
     sph__idx b;
     SPH__OMP_FOR(w->nb)
     for (b = 0; b < (sph__idx)w->nb; ++b)
         w->priv.b_thin[b] =
-            (uint8_t)(akinci || (double)sph__wall_kernel_sum(w, (size_t)b) < w->priv.thin_sum);
+            (uint8_t)(akinci || (double)sph__wall_kernel_sum_of(w, (size_t)b, 1) < w->priv.thin_sum);
     w->priv.b_thin_on = 1;
 }
 
@@ -5484,7 +5532,7 @@ static int sph__incompressible(int solver);
    volumes recomputed then. Shared by the search with and without a skin. */
 static sph_status sph__sort_by_cell(sph_world* w, sph_real cell) {
     const int akinci = w->def.boundary_volume == SPH_BVOL_AKINCI;
-    const int thin = w->dim == 3 && sph__incompressible((int)w->def.solver); /* sph__wall_thin */
+    const int thin = w->dim > 1; /* sph__wall_thin */
     sph__array arr[16];
     sph_status s;
     int narr;
@@ -6827,8 +6875,8 @@ static void sph__wall_normal(const sph__ctx* c, size_t i, const sph_real* x, sph
    corner of a box of single-layer walls with Akinci volumes (2D, dx 0.02, IISPH) shot a
    particle through the corner at 37 m/s, which flew off unreported; with the guard none passes.
    A particle that creeps into the line of a layer or a gap between its particles is the
-   contact's (its first push may follow the start's normal, sph__wall_contact). Returns 1 if it
-   acted. */
+   contact's (its first push may follow the start's normal, sph__wall_contact), and what gets
+   past both is sph__wall_crossed's. Returns 1 if it acted. */
 #define SPH__CROSS_MOVE 0.4
 static int sph__wall_cross_guard(const sph__ctx* c, size_t i, const sph_real* xold,
                                  const sph_real* gold, sph_real lead, sph_real* xi, sph_real* vi) {
@@ -6846,6 +6894,156 @@ static int sph__wall_cross_guard(const sph__ctx* c, size_t i, const sph_real* xo
     if (vn < 0)
         for (k = 0; k < D; ++k) vi[k] -= vn * gold[k] * n2;
     return 1;
+}
+
+/* The last line of a thin wall (sph__wall_thin: one layer, as a host samples a surface), after
+   the contact, for every particle near one however far it moved: did the step take it behind
+   the wall's face? Locally the wall is a plane (a line in 2D) through D of its particles. Of the
+   six (four in 2D) thin wall particles nearest to the particle's end x_e, every D that lie within
+   2.25 dx of each other are tried, nearest first; the particle crossed one if x_e lies behind it
+   and the step's start x_s in front (a start on the plane counts as in front), with x_e's foot on
+   the plane within the triangle (the segment) of those particles widened by a quarter of its
+   sides: past a thin plate's end the fluid flows round it, beside the plate's line, not through
+   it. Only a particle whose nearest wall particle is within 1.1 dx at the end is looked at (in
+   the middle of a square gap of a layer sampled at 1.5 dx it is 1.06 dx away), so a plane across
+   a channel between two layers 2.2 dx apart or more is never tried. More than the nearest D
+   are tried because at an edge the nearest D span two faces and make a chamfer the particle
+   may already be behind (with the nearest D + 1 only, 18 (IISPH) and 22 (PBF) of the 800
+   particles below still got out through the 3D box's edges). Such a particle goes back to where the step found it
+   (as with the guard above) and loses its velocity into the plane, relative to the nearest wall
+   particle. A step of two drifts (Stormer-Verlet: enhanced PCISPH, WCSPH's option) is looked at
+   whole, from x^n (sph__x_start): its first drift, before the search, has no lists to check
+   against, and enhanced PCISPH took 15 (2D) and 96 (3D) particles out through it.
+   The contact (sph__wall_contact) keeps centres d_c from wall particles, which closes a layer
+   sampled at the fluid's spacing, but not a gap wider than 2 d_c (a host's coarser sampling), nor
+   a wedge where its push follows a heavier wall's normal through a thin one. Measured, dam breaks
+   in a box whose single-layer walls a host sampled at 1.5 dx (default volumes, sph_advance in
+   0.02 s frames for 1 s), particles outside the walls before -> with the check, every frame
+   SPH_OK unless said: 2D (400 particles, dx 0.02) WCSPH 12 -> 0, original PCISPH 51 -> 0
+   (fails at 0.46 s, reported), enhanced 21 -> 0, IISPH 33 -> 0 (fails at 0.72 s, reported),
+   DFSPH 56 -> 0, PBF 72 -> 0 (fails at 0.14 s, reported; the failures: a particle the check
+   holds at a gap is compressed or driven past the speed bound by the fluid behind it;
+   tests/test_reliability.c, coarse_host_walls); 3D (800 particles, dx 0.04) 150, 209, 139, 519,
+   494 and 550 -> 0, 1, 0 (fails at 0.94 s, reported), 1, 2 and 3: fewer, not none. The original PCISPH's 3D dam break (1936
+   particles, dx 0.03) against a sphere of one layer (R 0.09 m, 0.02 m above the floor) put a
+   particle into the sphere at 0.94 s, now none (1.5 s). Not kept:
+   - lifting the particle besides to half a spacing in front of the plane (a wall's face at the
+     fluid's spacing) kept more particles moving, but added energy: the one-layer box of
+     tests/test_scenes.c's shell_3d rose 0.05 (the original PCISPH) and 0.0093 (DFSPH) of
+     rho g H^2 W above its start, against 0.005 allowed;
+   - the flip of the wall's normal -grad C between start and end: in a gap between wall
+     particles its component along the wall, towards the gap's middle, outweighs the normal one
+     near the layer, and the normals of a creeping step still agreed (the particles above went out
+     through the 1.5 dx gaps unnoticed);
+   - walls a callback moves: putting a particle back where the step found it, against walls that
+     moved since, let one particle out of the turning drums of tests/test_scenes.c (drum_2d:
+     IISPH and DFSPH; drum_3d: DFSPH and PBF) at 3.2-3.4 sqrt(g H): static walls only.
+   Thick walls are left to check_walls. Returns 1 if it acted. */
+#define SPH__CROSS_NEAR 6 /* wall particles the crossing check looks at (4 in 2D) */
+static int sph__wall_crossed(const sph__ctx* c, size_t i, const uint8_t* thin, const sph_real* xs,
+                             sph_real lead, sph_real lead_s, sph_real dx, sph_real* xi,
+                             sph_real* vi) {
+    const int D = c->dim, K = D == 3 ? SPH__CROSS_NEAR : 4;
+    const size_t k0 = c->fb->begin[i], k1 = k0 + c->fb->count[i];
+    const sph_real side2 = SPH__R(5.0625) * dx * dx; /* (2.25 dx)^2 */
+    sph_real r2n[SPH__CROSS_NEAR], dn[SPH__CROSS_NEAR][3];
+    size_t bn[SPH__CROSS_NEAR], kk;
+    int k, j, m = 0, v[3];
+    if (D < 2) return 0;
+    for (kk = k0; kk < k1; ++kk) { /* the K nearest thin wall particles, nearest first */
+        const size_t b = c->fb->idx[kk];
+        sph_real d[3] = {0, 0, 0}, r2 = 0;
+        if (!thin[b]) continue;
+        sph__wall_delta(c, xi, b, lead, d);
+        for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+        if (m == K && !(r2 < r2n[K - 1])) continue;
+        for (j = m < K ? m : K - 1; j > 0 && r2 < r2n[j - 1]; --j) { /* insert at j */
+            r2n[j] = r2n[j - 1];
+            bn[j] = bn[j - 1];
+            for (k = 0; k < 3; ++k) dn[j][k] = dn[j - 1][k];
+        }
+        r2n[j] = r2;
+        bn[j] = b;
+        for (k = 0; k < 3; ++k) dn[j][k] = d[k];
+        if (m < K) ++m;
+    }
+    if (m < D || !(r2n[0] < SPH__R(1.21) * dx * dx)) return 0;
+    /* every D of them (v[0] < v[1] < v[2]), nearest first */
+    for (v[0] = 0; v[0] < m; ++v[0])
+        for (v[1] = v[0] + 1; v[1] < m; ++v[1])
+            for (v[2] = D == 3 ? v[1] + 1 : 0; v[2] < (D == 3 ? m : 1); ++v[2]) {
+                sph_real e1[3] = {0, 0, 0}, e2[3] = {0, 0, 0}, nrm[3] = {0, 0, 0};
+                sph_real ds[3] = {0, 0, 0}, q[3], a11 = 0, a12 = 0, a22 = 0, b1 = 0, b2 = 0;
+                sph_real ss = 0, se = 0, n2 = 0, vn = 0, u, al, be;
+                const sph_real* vb;
+                /* the sides from the first: x_b' - x_b = d - d' (d = x_e - x_b); the normal */
+                for (k = 0; k < D; ++k) {
+                    e1[k] = dn[v[0]][k] - dn[v[1]][k];
+                    if (D == 3) e2[k] = dn[v[0]][k] - dn[v[2]][k];
+                }
+                if (D == 2) {
+                    nrm[0] = -e1[1];
+                    nrm[1] = e1[0];
+                } else {
+                    nrm[0] = e1[1] * e2[2] - e1[2] * e2[1];
+                    nrm[1] = e1[2] * e2[0] - e1[0] * e2[2];
+                    nrm[2] = e1[0] * e2[1] - e1[1] * e2[0];
+                }
+                for (k = 0; k < D; ++k) {
+                    a11 += e1[k] * e1[k];
+                    a12 += e1[k] * e2[k];
+                    a22 += e2[k] * e2[k];
+                    n2 += nrm[k] * nrm[k];
+                }
+                /* wall particles of one layer lie close together (sampled at up to 1.5 dx) */
+                if (!(a11 <= side2) || !(n2 > 0)) continue;
+                if (D == 3) { /* the other sides; three nearly in a line span no plane */
+                    sph_real e3 = 0;
+                    for (k = 0; k < 3; ++k) e3 += (e1[k] - e2[k]) * (e1[k] - e2[k]);
+                    if (!(a22 <= side2) || !(e3 <= side2) || !(n2 > SPH__R(0.03) * a11 * a22))
+                        continue;
+                }
+                sph__wall_delta(c, xs, bn[v[0]], lead_s, ds);
+                for (k = 0; k < D; ++k) {
+                    ss += ds[k] * nrm[k];
+                    se += dn[v[0]][k] * nrm[k];
+                }
+                /* the same side at both ends, or not behind it at the end */
+                if (!(ss * se < 0) && !(ss == 0 && se != 0)) continue;
+                if (ss < 0 || (ss == 0 && se > 0)) {
+                    for (k = 0; k < D; ++k) nrm[k] = -nrm[k];
+                    ss = -ss;
+                    se = -se;
+                }
+                /* the end's foot on the plane, from the first, within the widened triangle */
+                for (k = 0; k < D; ++k) {
+                    q[k] = dn[v[0]][k] - se / n2 * nrm[k];
+                    b1 += q[k] * e1[k];
+                    b2 += q[k] * e2[k];
+                }
+                if (D == 2) {
+                    al = b1 / a11;
+                    if (!(al >= SPH__R(-0.25) && al <= SPH__R(1.25))) continue;
+                } else {
+                    const sph_real det = a11 * a22 - a12 * a12;
+                    al = (b1 * a22 - b2 * a12) / det;
+                    be = (b2 * a11 - b1 * a12) / det;
+                    if (!(al >= SPH__R(-0.25) && be >= SPH__R(-0.25) && al + be <= SPH__R(1.25)))
+                        continue;
+                }
+                /* back to the start, without the velocity into the wall (relative to its
+                   nearest particle) */
+                vb = c->bv + bn[0] * (size_t)D;
+                u = 1 / sph__sqrt(n2);
+                for (k = 0; k < D; ++k) {
+                    xi[k] = xs[k];
+                    vn += (vi[k] - vb[k]) * nrm[k] * u;
+                }
+                if (vn < 0)
+                    for (k = 0; k < D; ++k) vi[k] -= vn * nrm[k] * u;
+                return 1;
+            }
+    return 0;
 }
 
 /* One particle's contact: its distance d [m] to the nearest wall particle (d_c, or less on the
@@ -7178,6 +7376,10 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
     const int ramp = D == 3 && sph__incompressible(w->priv.solver) &&
                      c->bp_mode == SPH_BP_ZERO && w->priv.full_count > 0;
     const sph_real inv_full = ramp ? 1 / (sph_real)w->priv.full_count : 0;
+    /* the thin walls' flags, for the crossing check (sph__wall_crossed; static walls only) */
+    const uint8_t* thin =
+        dc > 0 && w->priv.b_thin_on && !w->def.boundary_motion ? w->priv.b_thin : NULL;
+    const sph_real* xst = thin ? w->priv.x_start : NULL;
     /* the contact's displacements, for a carried density (sph__contact_density; the scratch
        comes from sph__step_begin) */
     sph_real* sh = dc > 0 && sph__carries_density_for(w, w->priv.solver) &&
@@ -7292,8 +7494,18 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                 }
                 if (guard && sph__wall_cross_guard(c, i, xold, gold, lead, xi, vi))
                     r[SPH__RED_CONTACT] += 1;
-                else if (sph__wall_contact(c, i, &ca, xold, xi, vi))
-                    r[SPH__RED_CONTACT] += 1;
+                else {
+                    const int pushed = sph__wall_contact(c, i, &ca, xold, xi, vi);
+                    /* from the step's start: x^n of a step of two drifts (sph__x_start) */
+                    const sph_real* xs0 =
+                        !xst ? xold
+                        : w->priv.sorts == w->priv.x_start_sorts
+                            ? xst + i * (size_t)D
+                            : xst + (size_t)w->priv.grid.order[i] * (size_t)D;
+                    if ((thin && sph__wall_crossed(c, i, thin, xs0, lead, lead - kx - (xst ? w->priv.x_start_drift : 0), w->dx, xi, vi)) ||
+                        pushed)
+                        r[SPH__RED_CONTACT] += 1;
+                }
             }
             if (sh) /* the contact's (and the guard's) displacement */
                 for (kk = 0; kk < D; ++kk) sh[i * (size_t)D + (size_t)kk] = xi[kk] - sh[i * (size_t)D + (size_t)kk];
@@ -7895,6 +8107,7 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
     sph_status s;
     int k;
     if (!w) return SPH_ERR_ARG;
+    w->priv.x_start = NULL; /* a step of two drifts sets it (sph__wall_crossed) */
     if (solver != SPH_SOLVER_COMPRESSIBLE)
         for (k = 0; k < w->nphase; ++k)
             if (w->phases[k].eos == SPH_EOS_IDEAL_GAS || w->phases[k].eos == SPH_EOS_STIFFENED_GAS)
@@ -7998,6 +8211,15 @@ static sph_status sph__prepare_forces(sph_world* w, sph__ctx* c, double t, doubl
     if (w->nb > 0) sph__stage_wall(w, c, SPH__WALL_STATE | SPH__WALL_PRESSURE);
     sph__time(w, SPH_STAGE_PRESSURE, t0);
     return SPH_OK;
+}
+
+/* A step of two drifts (Stormer-Verlet: WCSPH's and enhanced PCISPH's) keeps x^n for the final
+   drift's crossing check, which then looks at the whole step (sph__wall_crossed): the first
+   drift, before the neighbour search, has no wall lists to check against. */
+static void sph__x_start(sph_world* w, const sph_real* xn, sph_real drift) {
+    w->priv.x_start = xn;
+    w->priv.x_start_sorts = w->priv.sorts;
+    w->priv.x_start_drift = drift;
 }
 
 /* Stormer-Verlet drifts the particles half a step before its neighbour search. When the search
@@ -8199,6 +8421,7 @@ static sph_status sph__step_wcsph_verlet(sph_world* w, sph_real dt) {
     s = sph__scratch(w, &w->priv.xp, w->capacity * (size_t)w->dim);
     if (s != SPH_OK) return s;
     sph__copy(w->priv.xp, w->x, w->n * (size_t)w->dim * sizeof(sph_real));
+    sph__x_start(w, w->priv.xp, half);
     sph__ctx_init(w, &c);
     s = sph__integrate(w, &c, 0, 0, half, 0); /* drift */
     if (s != SPH_OK) return s;
@@ -8862,7 +9085,8 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt, double dt_prev) {
         (s = sph__scratch(w, &w->priv.xp, w->capacity * (size_t)D)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.vp, w->capacity * (size_t)D)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.pr2, w->capacity)) != SPH_OK ||
-        (s = sph__scratch(w, &w->priv.rho_n, w->capacity)) != SPH_OK)
+        (s = sph__scratch(w, &w->priv.rho_n, w->capacity)) != SPH_OK ||
+        (verlet && w->nb > 0 && (s = sph__scratch(w, &w->priv.xs, w->capacity * (size_t)D)) != SPH_OK))
         return s;
     if (2 * nblk > w->priv.block_cap) {
         if (!sph__grow((void**)&w->priv.block, 2 * nblk + 64, sizeof(double)))
@@ -8871,6 +9095,10 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt, double dt_prev) {
     }
     if (verlet) { /* first drift; the correction then runs at the half step */
         sph__copy(w->priv.xp, w->x, nD * sizeof(sph_real)); /* x^n for sph__undo_drift */
+        if (w->nb > 0) { /* and for the crossing check (xp holds predictions later) */
+            sph__copy(w->priv.xs, w->x, nD * sizeof(sph_real));
+            sph__x_start(w, w->priv.xs, SPH__R(0.5) * dt);
+        }
         sph__ctx_init(w, &c);
         s = sph__integrate(w, &c, 0, 0, SPH__R(0.5) * dt, 0);
         if (s != SPH_OK) return s;
