@@ -31,6 +31,17 @@ static const char* solver_name(const sph_world_def* d) {
     return d->scheme == SPH_SCHEME_SECOND_ORDER ? "WCSPH 2nd-order" : "WCSPH";
 }
 
+/* A world of def with one phase of water (1000 kg/m^3) filling the box lo..hi. */
+static void water_box(sph_world* w, const sph_world_def* def, const sph_real* lo,
+                      const sph_real* hi) {
+    sph_phase water;
+    memset(&water, 0, sizeof water);
+    water.rest_density = 1000;
+    CHECK_EQ_INT(sph_world_init(w, def), SPH_OK);
+    CHECK(sph_world_add_phase(w, &water) == 0);
+    CHECK_EQ_INT(sph_fill_box(w, 0, lo, hi), SPH_OK);
+}
+
 /* ---- confinement ------------------------------------------------------------------------- */
 
 /* Horizontal shaking at 1.2 Hz (the tank's first sloshing mode is near 1.1 Hz) with the
@@ -750,7 +761,6 @@ static void test_energy_check_gravity(void) {
         const double dx = dim == 2 ? 0.02 : 0.04;
         sph_world_def def = sph_world_def_default(dim);
         sph_world w;
-        sph_phase water;
         sph_real lo[3] = {0, 0, 0}, hi[3] = {0.4, 0.4, 0.4}, fh[3] = {0.4, 0.3, 0.4};
         sph_status s = SPH_OK;
         double t_ok, M;
@@ -758,11 +768,7 @@ static void test_energy_check_gravity(void) {
         if (which[q][2] >= 0) sph_world_def_pcisph(&def, which[q][2]);
         def.solver = (sph_solver)which[q][1];
         def.spacing = (sph_real)dx;
-        memset(&water, 0, sizeof water);
-        water.rest_density = 1000;
-        CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
-        CHECK(sph_world_add_phase(&w, &water) == 0);
-        CHECK_EQ_INT(sph_fill_box(&w, 0, lo, fh), SPH_OK);
+        water_box(&w, &def, lo, fh);
         CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 0, 0), SPH_OK);
         CHECK_EQ_INT(sph_set_hydrostatic(&w), SPH_OK);
         for (frame = 1; frame <= 50 && s == SPH_OK; ++frame) s = sph_advance(&w, (sph_real)0.02);
@@ -797,7 +803,6 @@ static void test_free_fall_not_runaway(void) {
     for (q = 0; q < 3; ++q) {
         sph_world_def def = sph_world_def_default(2);
         sph_world w;
-        sph_phase water;
         const sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)0.1, (sph_real)0.1, 0};
         sph_status s = SPH_OK;
         double vy = 0, M = 0;
@@ -805,11 +810,7 @@ static void test_free_fall_not_runaway(void) {
         int frame;
         def.solver = solvers[q];
         def.spacing = (sph_real)0.02;
-        memset(&water, 0, sizeof water);
-        water.rest_density = 1000;
-        CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
-        CHECK(sph_world_add_phase(&w, &water) == 0);
-        CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
+        water_box(&w, &def, lo, hi);
         for (frame = 1; frame <= 25 && s == SPH_OK; ++frame) s = sph_advance(&w, (sph_real)0.1);
         CHECK_MSG(s == SPH_OK, "%s: %s", solver_name(&def), w.error);
         for (i = 0; i < w.n; ++i) {
@@ -848,7 +849,6 @@ static void test_coarse_host_walls(void) {
     for (q = 0; q < 6; ++q) {
         sph_world_def def = sph_world_def_default(2);
         sph_world w;
-        sph_phase water;
         const sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)0.4, (sph_real)0.4};
         sph_real xb[2 * 200];
         size_t nb = 0, out_max = 0;
@@ -857,11 +857,7 @@ static void test_coarse_host_walls(void) {
         if (which[q][1] >= 0) sph_world_def_pcisph(&def, which[q][1]);
         def.solver = (sph_solver)which[q][0];
         def.spacing = (sph_real)dx;
-        memset(&water, 0, sizeof water);
-        water.rest_density = 1000;
-        CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
-        CHECK(sph_world_add_phase(&w, &water) == 0);
-        CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
+        water_box(&w, &def, lo, hi);
         /* the floor (a = 1) and the two sides (a = 0), half a spacing outside the box */
         for (a = 0; a < 2; ++a) {
             const int b = 1 - a, n = (int)ceil((L[b] + s) / s) + 1;
@@ -913,7 +909,6 @@ static void test_dense_host_walls(void) {
     for (q = 0; q < 3; ++q) {
         sph_world_def def = sph_world_def_default(2);
         sph_world w;
-        sph_phase water;
         const sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)W, (sph_real)H};
         sph_real* xb = (sph_real*)malloc(sizeof(sph_real) * 2 * 400);
         size_t nb = 0, i;
@@ -922,11 +917,7 @@ static void test_dense_host_walls(void) {
         int frame, k;
         def.solver = solvers[q];
         def.spacing = (sph_real)dx;
-        memset(&water, 0, sizeof water);
-        water.rest_density = 1000;
-        CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
-        CHECK(sph_world_add_phase(&w, &water) == 0);
-        CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_OK);
+        water_box(&w, &def, lo, hi);
         for (k = 0; k * s <= W + dx + 1e-9; ++k) { /* the floor, half a spacing below the box */
             xb[2 * nb] = (sph_real)(-0.5 * dx + k * s);
             xb[2 * nb + 1] = (sph_real)(-0.5 * dx);
