@@ -5356,36 +5356,35 @@ static void sph__stage_boundary_volume(sph_world* w) {
     for (b = 0; b < (sph__idx)w->nb; ++b) w->b_vol[b] = sph__akinci_volume(w, (size_t)b);
 }
 
-/* SPH_BVOL_AUTO: each wall particle keeps the larger of its given volume and Akinci's,
-   V_b = max(V_b, gamma_1 S / sum_b' W_bb'), once, when walls are added (or loaded). Akinci's
-   volume is below dx^dim wherever a lattice wall has several layers (0.585 dx^dim inside,
-   0.74 on the first layer, 0.59 at a 3D box's corner: Wendland C2 at h = 1.3 dx, gamma_1
-   0.585), so such walls keep their given volumes bit for bit (all but the edges and corners of
-   the outermost layer of sph_add_wall_box's walls, which lie beyond the fluid's reach); a wall
-   sampled as one layer (sum W that of a plane) gets the volume that gives the fluid beside it
-   its rest density (1.02 dx^2 on a straight 2D line of Wendland C2 at h = 1.3 dx).
-   Why: with dx^dim a layer weighs too little where its particles are sparse (the diagonal gaps
-   of a staircase a host samples from a circle: Akinci's volume there is 1.40 dx^dim, its mean
-   over a drum's layer 1.10 dx^2 in 2D and 1.05 dx^3 in 3D), so the fluid there stays short of
-   density, zero wall pressure lets it sink into the layer and the contact pushes it back onto
-   its neighbours. Measured on drums of one layer (R 0.3 m, a third full, at rest or turning at
-   2 rad/s): in 2D (dx 0.02) IISPH, DFSPH, both PCISPH and WCSPH failed within 0.05-1.95 s
-   (compressed by 20 %, reported); in 3D (dx 0.04) IISPH, DFSPH and PBF let a particle out
-   within 0.35-0.4 s, unreported. A wall particle with another closer than 0.7 dx (a host's
-   sampling denser than the fluid's, or the same point twice where two faces meet) takes
-   Akinci's volume alone: there dx^dim, the default, counts the wall's volume more than once (a
-   one-layer line at 0.5 dx: Akinci 0.51 dx^2 each, the max 1 dx^2). Between 0.7 and 1 dx the
-   max stays: with 0.9 dx the one-layer sphere of sph__wall_crossed's measurement (a host's
-   sampling at about dx) took Akinci's volumes and the original PCISPH's run let a particle into
-   it at 0.90 s; walls 0.75 dx apart still weigh too much (README, Limits). Measured: a 2D tank at rest
-   (0.6 x 0.3 m of water, dx 0.02) in walls of one layer 0.5 dx apart, default volumes, jumped at
-   the first step, and its energy rose 0.935 (IISPH), 0.927 (DFSPH) and 0.041 (PBF) of
-   rho g H^2 W within 0.5 s, every frame SPH_OK; now it never rises
-   (tests/test_reliability.c, dense_host_walls). A lattice
-   at dx (sph_add_wall_box) has no such pair. Both rules are idempotent (volumes computed again
-   after a load or a re-sort stay as they were); walls a callback moves keep the volumes of their
-   positions when added (a rigid motion keeps them right; walls that deform want
-   SPH_BVOL_AKINCI). */
+/* SPH_BVOL_AUTO: each wall particle keeps the larger of its given volume and Akinci's, V_b =
+   max(V_b, gamma_1 S / sum_b' W_bb'), once, when walls are added (or loaded). Akinci's volume
+   is below dx^dim wherever a lattice wall has several layers (0.585 dx^dim inside, 0.74 on the
+   first layer, 0.59 at a 3D box's corner: Wendland C2 at h = 1.3 dx, gamma_1 0.585), so such
+   walls keep their given volumes bit for bit (all but the edges and corners of the outermost
+   layer of sph_add_wall_box's walls, which lie beyond the fluid's reach); a wall sampled as one
+   layer (sum W that of a plane) gets the volume that gives the fluid beside it its rest density
+   (1.02 dx^2 on a straight 2D line of Wendland C2 at h = 1.3 dx). Why: with dx^dim a layer
+   weighs too little where its particles are sparse (the diagonal gaps of a staircase a host
+   samples from a circle: Akinci's volume there is 1.40 dx^dim, its mean over a drum's layer
+   1.10 dx^2 in 2D and 1.05 dx^3 in 3D), so the fluid there stays short of density, zero wall
+   pressure lets it sink into the layer and the contact pushes it back onto its neighbours.
+   Measured on drums of one layer (R 0.3 m, a third full, at rest or turning at 2 rad/s): in 2D
+   (dx 0.02) IISPH, DFSPH, both PCISPH and WCSPH failed within 0.05-1.95 s (compressed by 20 %,
+   reported); in 3D (dx 0.04) IISPH, DFSPH and PBF let a particle out within 0.35-0.4 s,
+   unreported. A wall particle with another closer than 0.7 dx (a host's sampling denser than
+   the fluid's, or the same point twice where two faces meet) takes Akinci's volume alone: there
+   dx^dim, the default, counts the wall's volume more than once (a one-layer line at 0.5 dx:
+   Akinci 0.51 dx^2 each, the max 1 dx^2). Between 0.7 and 1 dx the max stays: with 0.9 dx the
+   one-layer sphere of sph__wall_crossed's measurement (a host's sampling at about dx) took
+   Akinci's volumes and the original PCISPH's run let a particle into it at 0.90 s; walls 0.75
+   dx apart still weigh too much (README, Limits). Measured: a 2D tank at rest (0.6 x 0.3 m of
+   water, dx 0.02) in walls of one layer 0.5 dx apart, default volumes, jumped at the first
+   step, and its energy rose 0.935 (IISPH), 0.927 (DFSPH) and 0.041 (PBF) of rho g H^2 W within
+   0.5 s, every frame SPH_OK; now it never rises (tests/test_reliability.c, dense_host_walls). A
+   lattice at dx (sph_add_wall_box) has no such pair. Both rules are idempotent (volumes
+   computed again after a load or a re-sort stay as they were); walls a callback moves keep the
+   volumes of their positions when added (a rigid motion keeps them right; walls that deform
+   want SPH_BVOL_AKINCI). */
 static int sph__wall_dense(const sph_world* w, size_t b) {
     const int D = w->dim;
     const sph_neighbors* nl = &w->priv.bb;
@@ -5434,7 +5433,8 @@ static void sph__wall_thin(sph_world* w) {
     SPH__OMP_FOR(w->nb)
     for (b = 0; b < (sph__idx)w->nb; ++b)
         w->priv.b_thin[b] =
-            (uint8_t)(akinci || (double)sph__wall_kernel_sum_of(w, (size_t)b, 1) < w->priv.thin_sum);
+            (uint8_t)(akinci ||
+                      (double)sph__wall_kernel_sum_of(w, (size_t)b, 1) < w->priv.thin_sum);
     w->priv.b_thin_on = 1;
 }
 
@@ -6898,43 +6898,44 @@ static int sph__wall_cross_guard(const sph__ctx* c, size_t i, const sph_real* xo
 
 /* The last line of a thin wall (sph__wall_thin: one layer, as a host samples a surface), after
    the contact, for every particle near one however far it moved: did the step take it behind
-   the wall's face? Locally the wall is a plane (a line in 2D) through D of its particles. Of the
-   six (four in 2D) thin wall particles nearest to the particle's end x_e, every D that lie within
-   2.25 dx of each other are tried, nearest first; the particle crossed one if x_e lies behind it
-   and the step's start x_s in front (a start on the plane counts as in front), with x_e's foot on
-   the plane within the triangle (the segment) of those particles widened by a quarter of its
-   sides: past a thin plate's end the fluid flows round it, beside the plate's line, not through
-   it. Only a particle whose nearest wall particle is within 1.1 dx at the end is looked at (in
-   the middle of a square gap of a layer sampled at 1.5 dx it is 1.06 dx away), so a plane across
-   a channel between two layers 2.2 dx apart or more is never tried. More than the nearest D
-   are tried because at an edge the nearest D span two faces and make a chamfer the particle
-   may already be behind (with the nearest D + 1 only, 18 (IISPH) and 22 (PBF) of the 800
-   particles below still got out through the 3D box's edges). Such a particle goes back to where the step found it
-   (as with the guard above) and loses its velocity into the plane, relative to the nearest wall
-   particle. A step of two drifts (Stormer-Verlet: enhanced PCISPH, WCSPH's option) is looked at
-   whole, from x^n (sph__x_start): its first drift, before the search, has no lists to check
-   against, and enhanced PCISPH took 15 (2D) and 96 (3D) particles out through it.
-   The contact (sph__wall_contact) keeps centres d_c from wall particles, which closes a layer
-   sampled at the fluid's spacing, but not a gap wider than 2 d_c (a host's coarser sampling), nor
-   a wedge where its push follows a heavier wall's normal through a thin one. Measured, dam breaks
-   in a box whose single-layer walls a host sampled at 1.5 dx (default volumes, sph_advance in
-   0.02 s frames for 1 s), particles outside the walls before -> with the check, every frame
-   SPH_OK unless said: 2D (400 particles, dx 0.02) WCSPH 12 -> 0, original PCISPH 51 -> 0
-   (fails at 0.46 s, reported), enhanced 21 -> 0, IISPH 33 -> 0 (fails at 0.72 s, reported),
-   DFSPH 56 -> 0, PBF 72 -> 0 (fails at 0.14 s, reported; the failures: a particle the check
-   holds at a gap is compressed or driven past the speed bound by the fluid behind it;
-   tests/test_reliability.c, coarse_host_walls); 3D (800 particles, dx 0.04) 150, 209, 139, 519,
-   494 and 550 -> 0, 1, 0 (fails at 0.94 s, reported), 1, 2 and 3: fewer, not none. The original PCISPH's 3D dam break (1936
-   particles, dx 0.03) against a sphere of one layer (R 0.09 m, 0.02 m above the floor) put a
-   particle into the sphere at 0.94 s, now none (1.5 s). Not kept:
+   the wall's face? Locally the wall is a plane (a line in 2D) through D of its particles. Of
+   the six (four in 2D) thin wall particles nearest to the particle's end x_e, every D that lie
+   within 2.25 dx of each other are tried, nearest first; the particle crossed one if x_e lies
+   behind it and the step's start x_s in front (a start on the plane counts as in front), with
+   x_e's foot on the plane within the triangle (the segment) of those particles widened by a
+   quarter of its sides: past a thin plate's end the fluid flows round it, beside the plate's
+   line, not through it. Only a particle whose nearest wall particle is within 1.1 dx at the end
+   is looked at (in the middle of a square gap of a layer sampled at 1.5 dx it is 1.06 dx away),
+   so a plane across a channel between two layers 2.2 dx apart or more is never tried. More than
+   the nearest D are tried because at an edge the nearest D span two faces and make a chamfer
+   the particle may already be behind (with the nearest D + 1 only, 18 (IISPH) and 22 (PBF) of
+   the 800 particles below still got out through the 3D box's edges). Such a particle goes back
+   to where the step found it (as with the guard above) and loses its velocity into the plane,
+   relative to the nearest wall particle. A step of two drifts (Stormer-Verlet: enhanced PCISPH,
+   WCSPH's option) is looked at whole, from x^n (sph__x_start): its first drift, before the
+   search, has no lists to check against, and enhanced PCISPH took 15 (2D) and 96 (3D) particles
+   out through it. The contact (sph__wall_contact) keeps centres d_c from wall particles, which
+   closes a layer sampled at the fluid's spacing, but not a gap wider than 2 d_c (a host's
+   coarser sampling), nor a wedge where its push follows a heavier wall's normal through a thin
+   one. Measured, dam breaks in a box whose single-layer walls a host sampled at 1.5 dx (default
+   volumes, sph_advance in 0.02 s frames for 1 s), particles outside the walls before -> with
+   the check, every frame SPH_OK unless said: 2D (400 particles, dx 0.02) WCSPH 12 -> 0,
+   original PCISPH 51 -> 0 (fails at 0.46 s, reported), enhanced 21 -> 0, IISPH 33 -> 0 (fails
+   at 0.72 s, reported), DFSPH 56 -> 0, PBF 72 -> 0 (fails at 0.14 s, reported; the failures: a
+   particle the check holds at a gap is compressed or driven past the speed bound by the fluid
+   behind it; tests/test_reliability.c, coarse_host_walls); 3D (800 particles, dx 0.04) 150,
+   209, 139, 519, 494 and 550 -> 0, 1, 0 (fails at 0.94 s, reported), 1, 2 and 3: fewer, not
+   none. The original PCISPH's 3D dam break (1936 particles, dx 0.03) against a sphere of one
+   layer (R 0.09 m, 0.02 m above the floor) put a particle into the sphere at 0.94 s, now none
+   (1.5 s). Not kept:
    - lifting the particle besides to half a spacing in front of the plane (a wall's face at the
      fluid's spacing) kept more particles moving, but added energy: the one-layer box of
      tests/test_scenes.c's shell_3d rose 0.05 (the original PCISPH) and 0.0093 (DFSPH) of
      rho g H^2 W above its start, against 0.005 allowed;
    - the flip of the wall's normal -grad C between start and end: in a gap between wall
      particles its component along the wall, towards the gap's middle, outweighs the normal one
-     near the layer, and the normals of a creeping step still agreed (the particles above went out
-     through the 1.5 dx gaps unnoticed);
+     near the layer, and the normals of a creeping step still agreed (the particles above went
+     out through the 1.5 dx gaps unnoticed);
    - walls a callback moves: putting a particle back where the step found it, against walls that
      moved since, let one particle out of the turning drums of tests/test_scenes.c (drum_2d:
      IISPH and DFSPH; drum_3d: DFSPH and PBF) at 3.2-3.4 sqrt(g H): static walls only.
@@ -7502,7 +7503,8 @@ static sph_status sph__integrate_with(sph_world* w, const sph__ctx* c, const sph
                         : w->priv.sorts == w->priv.x_start_sorts
                             ? xst + i * (size_t)D
                             : xst + (size_t)w->priv.grid.order[i] * (size_t)D;
-                    if ((thin && sph__wall_crossed(c, i, thin, xs0, lead, lead - kx - (xst ? w->priv.x_start_drift : 0), w->dx, xi, vi)) ||
+                    const sph_real lead_s = lead - kx - (xst ? w->priv.x_start_drift : 0);
+                    if ((thin && sph__wall_crossed(c, i, thin, xs0, lead, lead_s, w->dx, xi, vi)) ||
                         pushed)
                         r[SPH__RED_CONTACT] += 1;
                 }
@@ -9086,7 +9088,8 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt, double dt_prev) {
         (s = sph__scratch(w, &w->priv.vp, w->capacity * (size_t)D)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.pr2, w->capacity)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.rho_n, w->capacity)) != SPH_OK ||
-        (verlet && w->nb > 0 && (s = sph__scratch(w, &w->priv.xs, w->capacity * (size_t)D)) != SPH_OK))
+        (verlet && w->nb > 0 &&
+         (s = sph__scratch(w, &w->priv.xs, w->capacity * (size_t)D)) != SPH_OK))
         return s;
     if (2 * nblk > w->priv.block_cap) {
         if (!sph__grow((void**)&w->priv.block, 2 * nblk + 64, sizeof(double)))
