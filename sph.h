@@ -350,8 +350,9 @@ int main(void) {
    walls are added: lattice walls of several layers keep their given volumes, a layer a host
    samples weighs as a full wall (with dx^dim it weighs too little where its particles are
    sparse: a 2D drum of one layer failed within 0.05 s under IISPH, a 3D one let particles out
-   unreported); a wall particle with another closer than 0.7 dx (walls sampled denser than the
-   fluid) takes Akinci's alone, or dx^dim each would weigh the wall twice or more.
+   unreported); where walls are sampled denser than the fluid, the given volume is capped by d^dim,
+   d the distance to the nearest other wall particle, or dx^dim each would weigh the wall twice or
+   more.
    Wall contact (def.wall_contact, on by default): no pressure scheme stops a particle that is
    short of fluid neighbours (a splash, the one-particle sheet a dam break spreads along the floor)
    from sinking until the wall supplies the volume it lacks, i.e. onto and past the wall's first
@@ -949,8 +950,9 @@ typedef enum sph_boundary_volume {
                            (default): a lattice wall of several layers keeps its given volumes
                            bit for bit within the fluid's reach (Akinci's are smaller there:
                            0.59-0.74 dx^dim), a wall a host samples as one layer weighs as a
-                           full wall; Akinci's alone where walls are sampled denser than 0.7
-                           dx (see sph__stage_boundary_volume_auto)                           */
+                           full wall; the given volume capped by d^dim, d the distance to
+                           the nearest wall particle, where walls are sampled denser than the
+                           fluid (see sph__stage_boundary_volume_auto)                        */
 } sph_boundary_volume;
 
 typedef enum sph_wall {
@@ -5371,42 +5373,55 @@ static void sph__stage_boundary_volume(sph_world* w) {
    Measured on drums of one layer (R 0.3 m, a third full, at rest or turning at 2 rad/s): in 2D
    (dx 0.02) IISPH, DFSPH, both PCISPH and WCSPH failed within 0.05-1.95 s (compressed by 20 %,
    reported); in 3D (dx 0.04) IISPH, DFSPH and PBF let a particle out within 0.35-0.4 s,
-   unreported. A wall particle with another closer than 0.7 dx (a host's sampling denser than
-   the fluid's, or the same point twice where two faces meet) takes Akinci's volume alone: there
-   dx^dim, the default, counts the wall's volume more than once (a one-layer line at 0.5 dx:
-   Akinci 0.51 dx^2 each, the max 1 dx^2). Between 0.7 and 1 dx the max stays: with 0.9 dx the
-   one-layer sphere of sph__wall_crossed's measurement (a host's sampling at about dx) took
-   Akinci's volumes and the original PCISPH's run let a particle into it at 0.90 s; walls 0.75
-   dx apart still weigh too much (README, Limits). Measured: a 2D tank at rest (0.6 x 0.3 m of
-   water, dx 0.02) in walls of one layer 0.5 dx apart, default volumes, jumped at the first
-   step, and its energy rose 0.935 (IISPH), 0.927 (DFSPH) and 0.041 (PBF) of rho g H^2 W within
-   0.5 s, every frame SPH_OK; now it never rises (tests/test_reliability.c, dense_host_walls). A
-   lattice at dx (sph_add_wall_box) has no such pair. Both rules are idempotent (volumes
+   unreported. Where the host samples a wall denser than the fluid, V_b = dx^dim counts the wall's
+   volume more than once (a one-layer line at 0.5 dx: Akinci 0.51 dx^2 each, dx^2 weighs it twice),
+   so the given volume is capped by d^dim, d the distance to the nearest other wall particle (a
+   lattice's spacing: the volume of a lattice at d; for the same point given twice, d = 0, Akinci's
+   alone): V_b = max(V_A, min(V_given, d^dim)). A one-layer wall gets Akinci's at any spacing
+   (V_A ~ dx s^(dim-1) > s^dim), a lattice of several layers at s < dx its s^dim (V_A, 0.59-0.74
+   s^dim, would weigh it too little), and a lattice at dx keeps its given volumes bit for bit (d^dim
+   within 3 % of them counts as them). Measured: a 2D tank at rest (0.6 x 0.3 m of water, dx 0.02)
+   in walls of one layer 0.5 dx apart jumped at the first step, and its energy rose 0.935 (IISPH),
+   0.927 (DFSPH) and 0.041 (PBF) of rho g H^2 W within 0.5 s, every frame SPH_OK; a rule that gave
+   Akinci's to pairs closer than 0.7 dx fixed that but left a 3D tank (dx 0.03) in walls of one
+   layer 0.75 dx apart gaining 180 J in its first frame (3.4 M g H; 10-16 J at 0.9 dx), unreported,
+   and its fluid refused at 0.5 dx as placed inside the walls (sph__check_placed weighed them with
+   the given volumes). Now none of these rises (tests/test_reliability.c, dense_host_walls). A
+   lattice at dx (sph_add_wall_box) is unchanged. Both rules are idempotent (volumes
    computed again after a load or a re-sort stay as they were); walls a callback moves keep the
    volumes of their positions when added (a rigid motion keeps them right; walls that deform
    want SPH_BVOL_AKINCI). */
-static int sph__wall_dense(const sph_world* w, size_t b) {
+/* the squared distance from wall particle b to its nearest other wall particle (the kernel's
+   reach squared if none is in reach) */
+static sph_real sph__wall_nearest2(const sph_world* w, size_t b) {
     const int D = w->dim;
     const sph_neighbors* nl = &w->priv.bb;
     const size_t k0 = nl->begin[b], k1 = k0 + nl->count[b];
-    const sph_real lim2 = SPH__R(0.49) * w->dx * w->dx;
+    sph_real near2 = w->kernel.radius * w->kernel.radius;
     size_t kk;
     for (kk = k0; kk < k1; ++kk) {
         sph_real d[3] = {0, 0, 0}, r2 = 0;
         int k;
         sph_grid_delta(&w->priv.bgrid, w->b_x + b * (size_t)D, w->b_x + nl->idx[kk] * (size_t)D, d);
         for (k = 0; k < D; ++k) r2 += d[k] * d[k];
-        if (r2 < lim2) return 1;
+        if (r2 < near2) near2 = r2;
     }
-    return 0;
+    return near2;
+}
+/* The rule, per wall particle, from its given volume, Akinci's and the squared distance to its
+   nearest wall neighbour: V_b = max(V_A, min(V_given, d^dim)). Also for sph__check_placed's look
+   before the first sort. */
+static sph_real sph__auto_volume(int dim, sph_real given, sph_real akinci, sph_real near2) {
+    const sph_real vs = dim == 1 ? sph__sqrt(near2) : dim == 2 ? near2 : near2 * sph__sqrt(near2);
+    const sph_real v = vs < SPH__R(0.97) * given ? vs : given; /* a lattice's rounding: given */
+    return akinci > v ? akinci : v;
 }
 static void sph__stage_boundary_volume_auto(sph_world* w) {
     sph__idx b;
     SPH__OMP_FOR(w->nb)
-    for (b = 0; b < (sph__idx)w->nb; ++b) {
-        const sph_real va = sph__akinci_volume(w, (size_t)b);
-        if (va > w->b_vol[b] || sph__wall_dense(w, (size_t)b)) w->b_vol[b] = va;
-    }
+    for (b = 0; b < (sph__idx)w->nb; ++b)
+        w->b_vol[b] = sph__auto_volume(w->dim, w->b_vol[b], sph__akinci_volume(w, (size_t)b),
+                                       sph__wall_nearest2(w, (size_t)b));
 }
 
 /* Which wall particles form a thin wall (one layer, as a host samples a surface): those whose
@@ -7960,27 +7975,65 @@ static void sph__rederive_sound_speed(sph_world* w) {
 /* sum_j V_j W(|x - p_j|) over the points p of grid g (built on p) within the kernel's support of
    x, V_j = vol[j] or, without vol, v0: the kernel sums of the checks before a step, which run
    before the step's lists exist. *buf (*cap entries, grown as needed) holds a query's result. */
+/* the points of p within the kernel's reach of x, their indices in *buf (grown as needed) */
+static sph_status sph__grid_within(const sph_world* w, const sph_grid* g, const sph_real* p,
+                                 const sph_real* x, uint32_t** buf, size_t* cap, size_t* m) {
+    *m = sph_grid_query(g, p, x, w->kernel.radius, *buf, *cap);
+    if (*m > *cap) { /* more neighbours than room: a larger buffer, the query again */
+        uint32_t* more = (uint32_t*)SPH_MALLOC(*m * sizeof(uint32_t));
+        if (!more) return SPH_ERR_NOMEM;
+        SPH_FREE(*buf);
+        *buf = more;
+        *cap = *m;
+        *m = sph_grid_query(g, p, x, w->kernel.radius, *buf, *cap);
+    }
+    return SPH_OK;
+}
+static double sph__grid_r2(const sph_world* w, const sph_grid* g, const sph_real* x,
+                           const sph_real* y) {
+    sph_real d[3] = {0, 0, 0}, r2 = 0;
+    int k;
+    sph_grid_delta(g, x, y, d);
+    for (k = 0; k < w->dim; ++k) r2 += d[k] * d[k];
+    return (double)r2;
+}
 static sph_status sph__grid_kernel_sum(const sph_world* w, const sph_grid* g, const sph_real* p,
                                        const sph_real* vol, double v0, const sph_real* x,
                                        uint32_t** buf, size_t* cap, double* sum) {
     const size_t D = (size_t)w->dim;
-    size_t m = sph_grid_query(g, p, x, w->kernel.radius, *buf, *cap), q;
+    size_t m = 0, q;
+    const sph_status s = sph__grid_within(w, g, p, x, buf, cap, &m);
     *sum = 0;
-    if (m > *cap) { /* more neighbours than room: a larger buffer, the query again */
-        uint32_t* more = (uint32_t*)SPH_MALLOC(m * sizeof(uint32_t));
-        if (!more) return SPH_ERR_NOMEM;
-        SPH_FREE(*buf);
-        *buf = more;
-        *cap = m;
-        m = sph_grid_query(g, p, x, w->kernel.radius, *buf, *cap);
-    }
     for (q = 0; q < m; ++q) {
-        sph_real d[3] = {0, 0, 0}, r2 = 0;
-        size_t k;
-        sph_grid_delta(g, x, p + (size_t)(*buf)[q] * D, d);
-        for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+        const double r2 = sph__grid_r2(w, g, x, p + (size_t)(*buf)[q] * D);
         *sum += (vol ? (double)vol[(*buf)[q]] : v0) *
-                (double)sph_kernel_w(&w->kernel, (sph_real)sqrt((double)r2));
+                (double)sph_kernel_w(&w->kernel, (sph_real)sqrt(r2));
+    }
+    return s;
+}
+
+/* The volumes SPH_BVOL_AUTO gives walls just added (sph__stage_boundary_volume_auto, which runs
+   at the first sort), from the walls' own grid: so the check below weighs a wall sampled denser
+   than the fluid as the step will. */
+static sph_status sph__placed_auto_volumes(const sph_world* w, const sph_grid* g, uint32_t** buf,
+                                           size_t* cap, sph_real* vol) {
+    const size_t D = (size_t)w->dim;
+    const double reach2 = (double)w->kernel.radius * (double)w->kernel.radius;
+    size_t b, m = 0, q;
+    for (b = 0; b < w->nb; ++b) {
+        const sph_real* xb = w->b_x + b * D;
+        double sum = 0, near2 = reach2;
+        const sph_status s = sph__grid_within(w, g, w->b_x, xb, buf, cap, &m);
+        if (s != SPH_OK) return s;
+        for (q = 0; q < m; ++q) {
+            const double r2 = sph__grid_r2(w, g, xb, w->b_x + (size_t)(*buf)[q] * D);
+            sum += (double)sph_kernel_w(&w->kernel, (sph_real)sqrt(r2));
+            if ((*buf)[q] != b && r2 < near2) near2 = r2;
+        }
+        vol[b] = sph__auto_volume(
+            w->dim, w->b_vol[b],
+            (sph_real)((double)w->def.boundary_gamma * (double)w->priv.lattice_sum / sum),
+            (sph_real)near2);
     }
     return SPH_OK;
 }
@@ -7998,6 +8051,7 @@ static sph_status sph__check_placed(sph_world* w) {
     const size_t D = (size_t)w->dim;
     sph_grid g;
     uint32_t* buf;
+    sph_real* vol = NULL; /* SPH_BVOL_AUTO's volumes of walls just added */
     size_t cap = 256, i, bad = (size_t)-1;
     double fbad = 0, sum = 0;
     sph_status s;
@@ -8009,13 +8063,19 @@ static sph_status sph__check_placed(sph_world* w) {
     if (s != SPH_OK) return sph__fail(w, s, -1, "step: the walls' grid: %s", sph_status_string(s));
     buf = (uint32_t*)SPH_MALLOC(cap * sizeof(uint32_t));
     s = buf ? sph_grid_build(&g, w->b_x, w->nb) : SPH_ERR_NOMEM;
+    if (s == SPH_OK && w->def.boundary_volume == SPH_BVOL_AUTO && w->priv.b_dirty) {
+        vol = (sph_real*)SPH_MALLOC(w->nb * sizeof(sph_real));
+        s = vol ? sph__placed_auto_volumes(w, &g, &buf, &cap, vol) : SPH_ERR_NOMEM;
+    }
     for (i = w->priv.placed_from; s == SPH_OK && i < w->n && bad == (size_t)-1; ++i) {
-        s = sph__grid_kernel_sum(w, &g, w->b_x, w->b_vol, 0, w->x + i * D, &buf, &cap, &sum);
+        s = sph__grid_kernel_sum(w, &g, w->b_x, vol ? vol : w->b_vol, 0, w->x + i * D, &buf, &cap,
+                                 &sum);
         if (s == SPH_OK && sum / (double)w->priv.lattice_sum > (double)w->priv.wall_fraction_max) {
             bad = i;
             fbad = sum / (double)w->priv.lattice_sum;
         }
     }
+    SPH_FREE(vol);
     SPH_FREE(buf);
     sph_grid_free(&g);
     if (s != SPH_OK) return sph__fail(w, s, -1, "step: out of memory (the walls' grid)");

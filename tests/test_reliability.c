@@ -893,61 +893,90 @@ static void test_coarse_host_walls(void) {
     }
 }
 
-/* Walls a host samples denser than the fluid. A 2D tank at rest (0.6 m wide, water 0.3 m deep,
-   dx 0.02, sph_set_hydrostatic) in a box whose walls are one layer of boundary particles 0.5 dx
-   apart (default volumes), IISPH, DFSPH and PBF through sph_advance in 0.02 s frames for 0.5 s:
-   every frame SPH_OK and the energy (kinetic + potential) never more than 0.5 % of rho g H^2 W
-   above its start. Each such particle used to keep dx^2 (the larger of the given volume and
-   Akinci's 0.51 dx^2), so the layer weighed twice a wall: the water jumped at the first step and
-   the energy rose 0.935 (IISPH), 0.927 (DFSPH) and 0.041 (PBF) of rho g H^2 W above its start,
-   every frame SPH_OK. Now a wall particle with another closer than 0.7 dx takes Akinci's volume
-   alone (sph__stage_boundary_volume_auto): the energy never rises. */
+/* One layer of boundary particles about s apart on the floor and the sides of the tank [0, L]
+   (L[1], the sides' top), half a fluid spacing dx outside it, sampled as a host samples the faces
+   of a tank: each face a grid from edge to edge (spacing len / ceil(len / s)), so the points
+   where faces meet appear twice. With xb NULL only counts. */
+static size_t host_tank(int D, double dx, double s, const double* L, sph_real* xb) {
+    const double o = 0.5 * dx;
+    size_t nb = 0;
+    int a, side;
+    for (a = 0; a < D; ++a)
+        for (side = 0; side < (a == 1 ? 1 : 2); ++side) {
+            int n[3] = {0, 0, 0}, j[3] = {0, 0, 0}, k;
+            double lo[3], len[3];
+            for (k = 0; k < D; ++k) {
+                lo[k] = -o;
+                len[k] = (k == 1 ? L[1] : L[k] + o) + o;
+                n[k] = k == a ? 0 : (int)ceil(len[k] / s - 1e-9);
+            }
+            for (;;) {
+                if (xb)
+                    for (k = 0; k < D; ++k)
+                        xb[nb * (size_t)D + (size_t)k] =
+                            (sph_real)(k == a ? (side ? L[a] + o : -o) : lo[k] + len[k] * j[k] / n[k]);
+                ++nb;
+                for (k = 0; k < D && ++j[k] > n[k]; ++k) j[k] = 0;
+                if (k == D) break;
+            }
+        }
+    return nb;
+}
+
+/* Walls a host samples denser than the fluid. A tank at rest (2D: 0.6 m wide, water 0.3 m deep,
+   dx 0.02; 3D: 0.3 x 0.15 m, 0.15 m deep, dx 0.03; sph_set_hydrostatic) in walls of one layer of
+   boundary particles 0.5 dx or 0.8 dx apart (default volumes), IISPH, DFSPH and PBF through
+   sph_advance in 0.02 s frames for 0.5 s: every frame SPH_OK and the energy (kinetic + potential)
+   never more than 0.5 % of M g H above its start. Each such particle used to keep dx^dim (the
+   larger of the given volume and Akinci's), so the layer weighed as walls sampled at dx several
+   times over. Measured before: the energy rose 0.935 (IISPH), 0.927 (DFSPH) and 0.041 (PBF) of M g H
+   in 2D at 0.5 dx; with a rule for pairs closer than 0.7 dx the 3D tank at 0.75 dx still rose 180 J
+   (3.4 M g H), at 0.9 dx 10-16 J, every frame SPH_OK, and at 0.5 dx the first step refused the world
+   ("fluid inside the wall layers", from the given volumes). Now a wall particle with another closer
+   than 0.95 dx takes Akinci's volume alone (sph__stage_boundary_volume_auto, and the check of
+   placed fluid with it). */
 static void test_dense_host_walls(void) {
     static const sph_solver solvers[3] = {SPH_SOLVER_IISPH, SPH_SOLVER_DFSPH, SPH_SOLVER_PBF};
-    const double dx = 0.02, s = 0.5 * dx, W = 0.6, H = 0.3, top = 0.45, g = 9.81;
-    int q;
-    for (q = 0; q < 3; ++q) {
-        sph_world_def def = sph_world_def_default(2);
-        sph_world w;
-        const sph_real lo[2] = {0, 0}, hi[2] = {(sph_real)W, (sph_real)H};
-        sph_real* xb = (sph_real*)malloc(sizeof(sph_real) * 2 * 400);
-        size_t nb = 0, i;
-        sph_status st = SPH_OK;
-        double e0 = 0, rise = 0;
-        int frame, k;
-        def.solver = solvers[q];
-        def.spacing = (sph_real)dx;
-        water_box(&w, &def, lo, hi);
-        for (k = 0; k * s <= W + dx + 1e-9; ++k) { /* the floor, half a spacing below the box */
-            xb[2 * nb] = (sph_real)(-0.5 * dx + k * s);
-            xb[2 * nb + 1] = (sph_real)(-0.5 * dx);
-            ++nb;
-        }
-        for (k = 1; k * s <= top + 0.5 * dx + 1e-9; ++k) { /* the sides */
-            xb[2 * nb] = (sph_real)(-0.5 * dx);
-            xb[2 * nb + 1] = (sph_real)(-0.5 * dx + k * s);
-            xb[2 * nb + 2] = (sph_real)(W + 0.5 * dx);
-            xb[2 * nb + 3] = (sph_real)(-0.5 * dx + k * s);
-            nb += 2;
-        }
-        CHECK_EQ_INT(sph_add_boundary(&w, nb, xb, NULL, 0), SPH_OK);
-        free(xb);
-        CHECK_EQ_INT(sph_set_hydrostatic(&w), SPH_OK);
-        for (i = 0; i < w.n; ++i) e0 += (double)w.mass * g * (double)w.x[2 * i + 1];
-        for (frame = 1; frame <= 25 && st == SPH_OK; ++frame) {
-            double e = w.stats.kinetic_energy;
-            st = sph_advance(&w, (sph_real)0.02);
-            e = w.stats.kinetic_energy;
-            for (i = 0; i < w.n; ++i) e += (double)w.mass * g * (double)w.x[2 * i + 1];
-            if (e - e0 > rise) rise = e - e0;
-        }
-        TH_NOTE("%-6s tank in walls of one layer 0.5 dx apart: %s at t = %.2f s, energy rise %.3g "
-                "of rho g H^2 W", solver_name(&def), st == SPH_OK ? "ok" : w.error, w.time,
-                rise / (1000 * g * H * H * W));
-        CHECK_MSG(st == SPH_OK, "%s: %s", solver_name(&def), w.error);
-        CHECK_LE(rise, 0.005 * 1000 * g * H * H * W);
-        sph_world_free(&w);
-    }
+    const double g = 9.81;
+    int D, f, q;
+    for (D = 2; D <= 3; ++D)
+        for (f = 0; f < 2; ++f)
+            for (q = 0; q < 3; ++q) {
+                const double dx = D == 2 ? 0.02 : 0.03, s = (f ? 0.8 : 0.5) * dx;
+                const double L[3] = {D == 2 ? 0.6 : 0.3, D == 2 ? 0.45 : 0.25, 0.15};
+                const double H = D == 2 ? 0.3 : 0.15;
+                sph_world_def def = sph_world_def_default(D);
+                sph_world w;
+                const sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)L[0], (sph_real)H, (sph_real)L[2]};
+                const size_t nb = host_tank(D, dx, s, L, NULL);
+                sph_real* xb = (sph_real*)malloc(sizeof(sph_real) * (size_t)D * nb);
+                size_t i;
+                sph_status st = SPH_OK;
+                double e0 = 0, rise = 0, M = 0;
+                int frame;
+                def.solver = solvers[q];
+                def.spacing = (sph_real)dx;
+                water_box(&w, &def, lo, hi);
+                host_tank(D, dx, s, L, xb);
+                CHECK_EQ_INT(sph_add_boundary(&w, nb, xb, NULL, 0), SPH_OK);
+                free(xb);
+                CHECK_EQ_INT(sph_set_hydrostatic(&w), SPH_OK);
+                for (i = 0; i < w.n; ++i) e0 += (double)w.mass * g * (double)w.x[(size_t)D * i + 1];
+                M = (double)w.mass * (double)w.n;
+                for (frame = 1; frame <= 25 && st == SPH_OK; ++frame) {
+                    double e;
+                    st = sph_advance(&w, (sph_real)0.02);
+                    e = w.stats.kinetic_energy;
+                    for (i = 0; i < w.n; ++i) e += (double)w.mass * g * (double)w.x[(size_t)D * i + 1];
+                    if (e - e0 > rise) rise = e - e0;
+                }
+                TH_NOTE("%-6s %dD tank in walls of one layer %.1f dx apart: %s at t = %.2f s, energy "
+                        "rise %.3g of M g H", solver_name(&def), D, s / dx,
+                        st == SPH_OK ? "ok" : w.error, w.time, rise / (M * g * H));
+                CHECK_MSG(st == SPH_OK, "%s: %s", solver_name(&def), w.error);
+                CHECK_LE(rise, 0.005 * M * g * H);
+                sph_world_free(&w);
+            }
 }
 
 const th_test tests_reliability[] = {
