@@ -471,9 +471,25 @@ int main(void) {
    PHASES (several fluids of different rest density)
    Recommended for layered or mixing liquids with density ratios down to 0.1: particle-density
    continuity (def.density = SPH_DENSITY_PARTICLE, Ott & Schnetter 2003 eq. 11) with
-     - enhanced PCISPH, sph_world_def_pcisph(&def, 1), which brings the multiphase gradient; or
+     - enhanced PCISPH, sph_world_def_pcisph(&def, 1), which brings the multiphase gradient but
+       sets Enhanced PCISPH 2018's continuity density: set def.density = SPH_DENSITY_PARTICLE
+       after it; or
      - WCSPH with def.pressure_grad = SPH_PGRAD_MULTIPHASE (eq. 12) or SPH_PGRAD_INTERFACE (Hu &
        Adams 2006).
+   Measured on a dam break (water column 0.2 x 0.4 m at the left of a 1.0 x 0.6 m tank of
+   sph_add_wall_box, the rest filled with a second phase, sph_set_hydrostatic, sph_advance in
+   0.02 s frames for 1 s, 2D dx 0.02, 3D dx 0.04 and 0.2 m deep): enhanced PCISPH with the
+   preset's continuity density failed at ratio 0.3 and below (0.1: within 0.06 s with the lighter
+   phase filling the tank to its lid, within 0.2 s with it 0.1 m below the lid), held 0.5; below
+   0.35 the first step now refuses it (SPH__CONTINUITY_RATIO_MIN). With particle density and the
+   lighter phase 0.1 m below the lid, ratio 0.1 runs the whole second (2D 109 retries, 3D 63; no
+   particle out, energy at most +0.17 % of M g H). Not with fluid that fills
+   its closed walls: there the correction runs with zero wall pressure (sph__enclosed), and
+   enhanced PCISPH fails in 3D even with equal densities (a tank full of water at rest: 0.28 s;
+   the dam break at 0.1, 0.01 and 0.001 within 0.16-0.26 s; in 2D they run, with 160-600
+   retries); WCSPH with particle density and the multiphase gradient runs the full tank's dam
+   break at 0.1 and 0.01 in 2D and 3D (energy at most +0.05 % of M g H, no particle out) and fails
+   at 0.001 (0.36 s, 0.38 s): for such ratios, and for gases, use the compressible step below.
    For interfaces that should overturn (Rayleigh-Taylor; the antisymmetric gradients slow them
    down 2-3 times): WCSPH with SPH_PGRAD_DIFFERENCE and def.shifting = 4 (see WCSPH).
    Both gradients are divided by the kernel gradient's lattice moment (0.974 for Wendland C2 at
@@ -8012,9 +8028,9 @@ static sph_status sph__grid_kernel_sum(const sph_world* w, const sph_grid* g, co
     return s;
 }
 
-/* The volumes SPH_BVOL_AUTO gives walls just added (sph__stage_boundary_volume_auto, which runs
-   at the first sort), from the walls' own grid: so the check below weighs a wall sampled denser
-   than the fluid as the step will. */
+/* The volumes SPH_BVOL_AUTO or SPH_BVOL_AKINCI give walls just added (sph__stage_boundary_volume
+   and _auto, which run at the first sort), from the walls' own grid: so the checks below weigh a
+   wall sampled denser than the fluid as the step will. */
 static sph_status sph__placed_auto_volumes(const sph_world* w, const sph_grid* g, uint32_t** buf,
                                            size_t* cap, sph_real* vol) {
     const size_t D = (size_t)w->dim;
@@ -8030,10 +8046,9 @@ static sph_status sph__placed_auto_volumes(const sph_world* w, const sph_grid* g
             sum += (double)sph_kernel_w(&w->kernel, (sph_real)sqrt(r2));
             if ((*buf)[q] != b && r2 < near2) near2 = r2;
         }
-        vol[b] = sph__auto_volume(
-            w->dim, w->b_vol[b],
-            (sph_real)((double)w->def.boundary_gamma * (double)w->priv.lattice_sum / sum),
-            (sph_real)near2);
+        vol[b] = (sph_real)((double)w->def.boundary_gamma * (double)w->priv.lattice_sum / sum);
+        if (w->def.boundary_volume == SPH_BVOL_AUTO)
+            vol[b] = sph__auto_volume(w->dim, w->b_vol[b], vol[b], (sph_real)near2);
     }
     return SPH_OK;
 }
@@ -8046,39 +8061,78 @@ static sph_status sph__placed_auto_volumes(const sph_world* w, const sph_grid* g
    ("time step too large", a particle at 39 m/s) after every retry. Fluid closer to a wall than
    the lattice's spacing but short of its first layer is left to the wall contact. Only the fluid
    added since the last step is checked, unless walls were added: the walls are sorted into a
-   grid of their own (sph_grid) and each fluid particle queried, about a neighbour search. */
-static sph_status sph__check_placed(sph_world* w) {
+   grid of their own (sph_grid) and each fluid particle queried, about a neighbour search.
+   Fluid crowded into walls or other fluid (check_walls; the incompressible solvers and PBF): a
+   newly placed fluid particle whose volume fraction of a full neighbourhood, (sum_j dx^dim W_ij +
+   sum_b V_b W_ib) / S over fluid and walls, is above SPH__PLACED_FILL starts compressed by as much,
+   and these solvers remove a compression within a step or a few, releasing it as motion (WCSPH
+   stores it in its equation of state and gives it back at the sound speed's pace; the
+   compressible step is for gases). Measured: a tank at rest (0.6 m wide, water 0.3 m deep) in
+   walls of one layer a host placed closer than a spacing to the fluid, IISPH through sph_advance,
+   frames of 0.02 s, every frame SPH_OK: walls on the fluid box's faces (0.5 dx from it; fraction
+   1.25 in 2D), energy up 16.7 M g H within 0.12 s and particles thrown out of the tank; 0.75 dx
+   away in 3D (1.26), 7.8 M g H within 0.08 s; 0.8 dx in 3D (1.20) 1.2 M g H. Below the bound
+   the release is smaller but not nothing (3D at 0.9 dx, 1.10: 0.12 M g H; 2D at 0.75 dx, 1.15:
+   0.46), and the tests' own scenes place fluid up to 1.13 (walls a host samples 1.5 dx apart, a
+   paddle placed into the fluid): SPH_ERR_ARG, named, the world unchanged. Only where the walls
+   overfill it (the fluid's own part below 1.01): fluid placed into fluid (an emitter onto a pool)
+   is pushed apart, both sides giving way (tests/test_hostile.c, fluid_added_into_fluid). */
+#define SPH__PLACED_FILL 1.2
+static sph_status sph__check_placed(sph_world* w, sph_solver solver) {
     const size_t D = (size_t)w->dim;
-    sph_grid g;
+    const int walls = w->nb > 0 && w->def.boundary_volume != SPH_BVOL_AKINCI &&
+                      w->priv.wall_fraction_max > 0;
+    const int fill = sph__incompressible((int)solver); /* PBF included */
+    sph_grid g, gf;
     uint32_t* buf;
-    sph_real* vol = NULL; /* SPH_BVOL_AUTO's volumes of walls just added */
-    size_t cap = 256, i, bad = (size_t)-1;
-    double fbad = 0, sum = 0;
-    sph_status s;
-    if (!w->def.check_walls || w->nb == 0 || w->def.boundary_volume == SPH_BVOL_AKINCI ||
-        !(w->priv.wall_fraction_max > 0) || w->priv.placed_from >= w->n)
-        return SPH_OK;
+    sph_real* vol = NULL; /* the default or Akinci's volumes of walls just added */
+    size_t cap = 256, i, bad = (size_t)-1, crowd = (size_t)-1;
+    double fbad = 0, fcrowd = 0, vdx = 1, sum = 0, sf = 0;
+    sph_status s, sg;
+    int k;
+    if (!w->def.check_walls || (!walls && !fill) || w->priv.placed_from >= w->n) return SPH_OK;
+    for (k = 0; k < w->dim; ++k) vdx *= (double)w->dx;
     s = sph_grid_init(&g, w->dim, w->kernel.radius, w->def.periodic, w->def.domain_lo,
                       w->def.domain_hi);
-    if (s != SPH_OK) return sph__fail(w, s, -1, "step: the walls' grid: %s", sph_status_string(s));
+    sg = sph_grid_init(&gf, w->dim, w->kernel.radius, w->def.periodic, w->def.domain_lo,
+                       w->def.domain_hi);
+    if (s != SPH_OK || sg != SPH_OK) {
+        if (s == SPH_OK) sph_grid_free(&g);
+        if (sg == SPH_OK) sph_grid_free(&gf);
+        s = s != SPH_OK ? s : sg;
+        return sph__fail(w, s, -1, "step: the placement check's grid: %s", sph_status_string(s));
+    }
     buf = (uint32_t*)SPH_MALLOC(cap * sizeof(uint32_t));
-    s = buf ? sph_grid_build(&g, w->b_x, w->nb) : SPH_ERR_NOMEM;
-    if (s == SPH_OK && w->def.boundary_volume == SPH_BVOL_AUTO && w->priv.b_dirty) {
+    s = buf ? SPH_OK : SPH_ERR_NOMEM;
+    if (s == SPH_OK && fill) s = sph_grid_build(&gf, w->x, w->n);
+    if (s == SPH_OK && w->nb > 0) s = sph_grid_build(&g, w->b_x, w->nb);
+    if (s == SPH_OK && w->nb > 0 && w->def.boundary_volume != SPH_BVOL_GIVEN && w->priv.b_dirty) {
         vol = (sph_real*)SPH_MALLOC(w->nb * sizeof(sph_real));
         s = vol ? sph__placed_auto_volumes(w, &g, &buf, &cap, vol) : SPH_ERR_NOMEM;
     }
     for (i = w->priv.placed_from; s == SPH_OK && i < w->n && bad == (size_t)-1; ++i) {
-        s = sph__grid_kernel_sum(w, &g, w->b_x, vol ? vol : w->b_vol, 0, w->x + i * D, &buf, &cap,
-                                 &sum);
-        if (s == SPH_OK && sum / (double)w->priv.lattice_sum > (double)w->priv.wall_fraction_max) {
+        const sph_real* xi = w->x + i * D;
+        sum = sf = 0;
+        if (w->nb > 0)
+            s = sph__grid_kernel_sum(w, &g, w->b_x, vol ? vol : w->b_vol, 0, xi, &buf, &cap, &sum);
+        if (s == SPH_OK && fill)
+            s = sph__grid_kernel_sum(w, &gf, w->x, NULL, vdx, xi, &buf, &cap, &sf);
+        sum /= (double)w->priv.lattice_sum;
+        sf = sf / (double)w->priv.lattice_sum + sum;
+        if (s == SPH_OK && walls && sum > (double)w->priv.wall_fraction_max) {
             bad = i;
-            fbad = sum / (double)w->priv.lattice_sum;
+            fbad = sum;
+        } else if (s == SPH_OK && fill && sf > SPH__PLACED_FILL && sf - sum < 1.01 &&
+                   crowd == (size_t)-1) { /* the walls fill it up: the fluid alone does not */
+            crowd = i;
+            fcrowd = sf;
         }
     }
     SPH_FREE(vol);
     SPH_FREE(buf);
     sph_grid_free(&g);
-    if (s != SPH_OK) return sph__fail(w, s, -1, "step: out of memory (the walls' grid)");
+    sph_grid_free(&gf);
+    if (s != SPH_OK) return sph__fail(w, s, -1, "step: out of memory (the placement check)");
     if (bad != (size_t)-1) {
         const sph_real* xb = w->x + bad * D;
         return sph__fail(w, SPH_ERR_ARG, (long)bad,
@@ -8088,6 +8142,17 @@ static sph_status sph__check_placed(sph_world* w) {
                          "the fluid?); remove it",
                          bad, (unsigned)w->id[bad], (double)xb[0], D > 1 ? (double)xb[1] : 0.0,
                          D > 2 ? (double)xb[2] : 0.0, fbad, (double)w->priv.wall_fraction_max);
+    }
+    if (crowd != (size_t)-1) {
+        const sph_real* xb = w->x + crowd * D;
+        return sph__fail(w, SPH_ERR_ARG, (long)crowd,
+                         "fluid particle %zu (id %u) at (%g, %g, %g) starts compressed: fluid and "
+                         "walls within its reach fill %g of a full neighbourhood (more than %g), "
+                         "so the step would release the compression as motion; fluid placed "
+                         "closer than a spacing to walls or to other fluid (walls on the faces "
+                         "of the fluid's box? place them half a spacing outside it)",
+                         crowd, (unsigned)w->id[crowd], (double)xb[0], D > 1 ? (double)xb[1] : 0.0,
+                         D > 2 ? (double)xb[2] : 0.0, fcrowd, SPH__PLACED_FILL);
     }
     return SPH_OK;
 }
@@ -8164,6 +8229,14 @@ static sph_status sph__check_free_surface(sph_world* w) {
    21 m/s in its first frame, every frame SPH_OK (the energy check's allowance grows with the
    kinetic energy the spurious pressure makes). Below this ratio they refuse to step. */
 #define SPH__SUMMED_RATIO_MIN 0.75
+/* PCISPH with the mass continuity equation (sph_world_def_pcisph's enhanced preset): a light
+   particle at an interface takes its heavy neighbours' masses into its density rate. Measured
+   (tests/test_pcisph.c, two_layer: water under a lighter fluid at rest, 2D, dx 0.05): holds at
+   0.8 and 0.4, fails at 0.2 (SPH_ERR_UNSTABLE, after steps); a dam break (a water column 0.2 x
+   0.4 m in a 1 x 0.6 m tank filled with a second phase, 2D dx 0.02) holds at 0.5 and fails at 0.3
+   and below (0.1: within 0.06 s). Below this ratio it refuses to step; with particle density
+   (Ott & Schnetter 2003) the same solver holds every ratio of the two-layer test. */
+#define SPH__CONTINUITY_RATIO_MIN 0.35
 
 static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) {
     sph_status s;
@@ -8193,14 +8266,23 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
                          "step: phases of rest densities in the ratio %g (below %g): %s sums the "
                          "density, which smears the mass jump between phases (a light blob "
                          "rising in water gains energy); for phases of different density use "
-                         "enhanced PCISPH or WCSPH with def.density = SPH_DENSITY_PARTICLE "
-                         "(sph.h, PHASES)",
+                         "def.density = SPH_DENSITY_PARTICLE with enhanced PCISPH "
+                         "(sph_world_def_pcisph(&def, 1), then the density) or WCSPH, for 1000:1 "
+                         "with the compressible step (sph.h, PHASES)",
                          sph__rest_density_ratio(w), SPH__SUMMED_RATIO_MIN,
                          solver == SPH_SOLVER_IISPH ? "IISPH" : "DFSPH");
+    if (solver == SPH_SOLVER_PCISPH && w->def.density == SPH_DENSITY_CONTINUITY &&
+        sph__rest_density_ratio(w) < SPH__CONTINUITY_RATIO_MIN)
+        return sph__fail(w, SPH_ERR_ARG, -1,
+                         "step: phases of rest densities in the ratio %g (below %g) with "
+                         "def.density = SPH_DENSITY_CONTINUITY, which gives a light particle at "
+                         "an interface its heavy neighbours' masses: set def.density = "
+                         "SPH_DENSITY_PARTICLE after sph_world_def_pcisph (sph.h, PHASES)",
+                         sph__rest_density_ratio(w), SPH__CONTINUITY_RATIO_MIN);
     s = sph__check_step_input(w, dt);
     if (s != SPH_OK) return s;
     if (w->priv.placed) { /* fluid or walls added since the last step */
-        s = sph__check_placed(w);
+        s = sph__check_placed(w, solver);
         if (s == SPH_OK) s = sph__check_free_surface(w);
         if (s != SPH_OK) return s;
         w->priv.placed = 0;
