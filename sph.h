@@ -8028,6 +8028,18 @@ static sph_status sph__grid_kernel_sum(const sph_world* w, const sph_grid* g, co
     return s;
 }
 
+/* Two grids at the kernel's reach over the world's domain (the placement checks' fluid and walls);
+   on failure neither is left allocated. */
+static sph_status sph__grid_pair_init(const sph_world* w, sph_grid* ga, sph_grid* gb) {
+    sph_status s = sph_grid_init(ga, w->dim, w->kernel.radius, w->def.periodic, w->def.domain_lo,
+                                 w->def.domain_hi);
+    if (s != SPH_OK) return s;
+    s = sph_grid_init(gb, w->dim, w->kernel.radius, w->def.periodic, w->def.domain_lo,
+                      w->def.domain_hi);
+    if (s != SPH_OK) sph_grid_free(ga);
+    return s;
+}
+
 /* The volumes SPH_BVOL_AUTO or SPH_BVOL_AKINCI give walls just added (sph__stage_boundary_volume
    and _auto, which run at the first sort), from the walls' own grid: so the checks below weigh a
    wall sampled denser than the fluid as the step will. */
@@ -8088,20 +8100,13 @@ static sph_status sph__check_placed(sph_world* w, sph_solver solver) {
     sph_real* vol = NULL; /* the default or Akinci's volumes of walls just added */
     size_t cap = 256, i, bad = (size_t)-1, crowd = (size_t)-1;
     double fbad = 0, fcrowd = 0, vdx = 1, sum = 0, sf = 0;
-    sph_status s, sg;
+    sph_status s;
     int k;
     if (!w->def.check_walls || (!walls && !fill) || w->priv.placed_from >= w->n) return SPH_OK;
     for (k = 0; k < w->dim; ++k) vdx *= (double)w->dx;
-    s = sph_grid_init(&g, w->dim, w->kernel.radius, w->def.periodic, w->def.domain_lo,
-                      w->def.domain_hi);
-    sg = sph_grid_init(&gf, w->dim, w->kernel.radius, w->def.periodic, w->def.domain_lo,
-                       w->def.domain_hi);
-    if (s != SPH_OK || sg != SPH_OK) {
-        if (s == SPH_OK) sph_grid_free(&g);
-        if (sg == SPH_OK) sph_grid_free(&gf);
-        s = s != SPH_OK ? s : sg;
+    s = sph__grid_pair_init(w, &g, &gf);
+    if (s != SPH_OK)
         return sph__fail(w, s, -1, "step: the placement check's grid: %s", sph_status_string(s));
-    }
     buf = (uint32_t*)SPH_MALLOC(cap * sizeof(uint32_t));
     s = buf ? SPH_OK : SPH_ERR_NOMEM;
     if (s == SPH_OK && fill) s = sph_grid_build(&gf, w->x, w->n);
@@ -8176,20 +8181,13 @@ static sph_status sph__check_free_surface(sph_world* w) {
     sph_grid gf, gb;
     uint32_t* buf;
     size_t cap = 256, i, bad = (size_t)-1;
-    sph_status s, sg;
+    sph_status s;
     int k;
     if (w->def.pressure_grad != SPH_PGRAD_DIFFERENCE || w->n == 0) return SPH_OK;
     for (k = 0; k < w->dim; ++k) vdx *= (double)w->dx;
-    s = sph_grid_init(&gf, w->dim, w->kernel.radius, w->def.periodic, w->def.domain_lo,
-                      w->def.domain_hi);
-    sg = sph_grid_init(&gb, w->dim, w->kernel.radius, w->def.periodic, w->def.domain_lo,
-                       w->def.domain_hi);
-    if (s != SPH_OK || sg != SPH_OK) {
-        if (s == SPH_OK) sph_grid_free(&gf);
-        if (sg == SPH_OK) sph_grid_free(&gb);
-        s = s != SPH_OK ? s : sg;
+    s = sph__grid_pair_init(w, &gf, &gb);
+    if (s != SPH_OK)
         return sph__fail(w, s, -1, "step: the free-surface check's grid: %s", sph_status_string(s));
-    }
     buf = (uint32_t*)SPH_MALLOC(cap * sizeof(uint32_t));
     s = buf ? sph_grid_build(&gf, w->x, w->n) : SPH_ERR_NOMEM;
     if (s == SPH_OK && w->nb > 0) s = sph_grid_build(&gb, w->b_x, w->nb);
