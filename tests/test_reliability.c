@@ -931,7 +931,7 @@ static size_t host_tank(int D, double o, double s, const double* L, sph_real* xb
    larger of the given volume and Akinci's), so the layer weighed as walls sampled at dx several
    times over. Measured before: the energy rose 0.935 (IISPH), 0.927 (DFSPH) and 0.041 (PBF) of M g H
    in 2D at 0.5 dx; with a rule for pairs closer than 0.7 dx the 3D tank at 0.75 dx still rose 180 J
-   (3.4 M g H), at 0.9 dx 10-16 J, every frame SPH_OK, and at 0.5 dx the first step refused the world
+   (1.7 M g H), at 0.9 dx 10-16 J, every frame SPH_OK, and at 0.5 dx the first step refused the world
    ("fluid inside the wall layers", from the given volumes). Now a wall particle with another closer
    than 0.95 dx takes Akinci's volume alone (sph__stage_boundary_volume_auto, and the check of
    placed fluid with it). */
