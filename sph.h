@@ -7988,12 +7988,9 @@ static void sph__rederive_sound_speed(sph_world* w) {
             w->phases[q].sound_speed = old[q];
 }
 
-/* sum_j V_j W(|x - p_j|) over the points p of grid g (built on p) within the kernel's support of
-   x, V_j = vol[j] or, without vol, v0: the kernel sums of the checks before a step, which run
-   before the step's lists exist. *buf (*cap entries, grown as needed) holds a query's result. */
 /* the points of p within the kernel's reach of x, their indices in *buf (grown as needed) */
 static sph_status sph__grid_within(const sph_world* w, const sph_grid* g, const sph_real* p,
-                                 const sph_real* x, uint32_t** buf, size_t* cap, size_t* m) {
+                                   const sph_real* x, uint32_t** buf, size_t* cap, size_t* m) {
     *m = sph_grid_query(g, p, x, w->kernel.radius, *buf, *cap);
     if (*m > *cap) { /* more neighbours than room: a larger buffer, the query again */
         uint32_t* more = (uint32_t*)SPH_MALLOC(*m * sizeof(uint32_t));
@@ -8013,6 +8010,9 @@ static double sph__grid_r2(const sph_world* w, const sph_grid* g, const sph_real
     for (k = 0; k < w->dim; ++k) r2 += d[k] * d[k];
     return (double)r2;
 }
+/* sum_j V_j W(|x - p_j|) over the points p of grid g (built on p) within the kernel's support of
+   x, V_j = vol[j] or, without vol, v0: the kernel sums of the checks before a step, which run
+   before the step's lists exist. *buf (*cap entries, grown as needed) holds a query's result. */
 static sph_status sph__grid_kernel_sum(const sph_world* w, const sph_grid* g, const sph_real* p,
                                        const sph_real* vol, double v0, const sph_real* x,
                                        uint32_t** buf, size_t* cap, double* sum) {
