@@ -914,9 +914,11 @@ static size_t host_tank(int D, double o, double s, const double* L, sph_real* xb
                 if (xb)
                     for (k = 0; k < D; ++k)
                         xb[nb * (size_t)D + (size_t)k] =
-                            (sph_real)(k == a ? (side ? L[a] + o : -o) : lo[k] + len[k] * j[k] / n[k]);
+                            (sph_real)(k == a ? (side ? L[a] + o : -o)
+                                              : lo[k] + len[k] * j[k] / n[k]);
                 ++nb;
-                for (k = 0; k < D && ++j[k] > n[k]; ++k) j[k] = 0;
+                for (k = 0; k < D && ++j[k] > n[k]; ++k)
+                    j[k] = 0;
                 if (k == D) break;
             }
         }
@@ -929,12 +931,13 @@ static size_t host_tank(int D, double o, double s, const double* L, sph_real* xb
    sph_advance in 0.02 s frames for 0.5 s: every frame SPH_OK and the energy (kinetic + potential)
    never more than 0.5 % of M g H above its start. Each such particle used to keep dx^dim (the
    larger of the given volume and Akinci's), so the layer weighed as walls sampled at dx several
-   times over. Measured before: the energy rose 0.935 (IISPH), 0.927 (DFSPH) and 0.041 (PBF) of M g H
-   in 2D at 0.5 dx; with a rule for pairs closer than 0.7 dx the 3D tank at 0.75 dx still rose 180 J
-   (1.7 M g H), at 0.9 dx 10-16 J, every frame SPH_OK, and at 0.5 dx the first step refused the world
-   ("fluid inside the wall layers", from the given volumes). Now a wall particle with another closer
-   than 0.95 dx takes Akinci's volume alone (sph__stage_boundary_volume_auto, and the check of
-   placed fluid with it). */
+   times over. Measured before: in 2D at 0.5 dx the energy rose 0.935 (IISPH), 0.927 (DFSPH) and
+   0.041 (PBF) of M g H; with a rule that gave pairs closer than 0.7 dx Akinci's volume, the 3D
+   tank at 0.8 dx still rose 1.80 (IISPH), 1.99 (DFSPH) and 0.157 (PBF) of M g H, the 2D one 0.042
+   and 0.043, every frame SPH_OK, and at 0.5 dx the first step refused the 3D world ("inside the
+   wall layers", from the given volumes). Now the given volume is capped by d^dim, d the distance
+   to the nearest other wall particle (sph__stage_boundary_volume_auto, and the placement check
+   with the same volumes). */
 static void test_dense_host_walls(void) {
     static const sph_solver solvers[3] = {SPH_SOLVER_IISPH, SPH_SOLVER_DFSPH, SPH_SOLVER_PBF};
     const double g = 9.81;
@@ -947,7 +950,8 @@ static void test_dense_host_walls(void) {
                 const double H = D == 2 ? 0.3 : 0.15;
                 sph_world_def def = sph_world_def_default(D);
                 sph_world w;
-                const sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)L[0], (sph_real)H, (sph_real)L[2]};
+                const sph_real lo[3] = {0, 0, 0},
+                               hi[3] = {(sph_real)L[0], (sph_real)H, (sph_real)L[2]};
                 const size_t nb = host_tank(D, 0.5 * dx, s, L, NULL);
                 sph_real* xb = (sph_real*)malloc(sizeof(sph_real) * (size_t)D * nb);
                 size_t i;
@@ -961,18 +965,22 @@ static void test_dense_host_walls(void) {
                 CHECK_EQ_INT(sph_add_boundary(&w, nb, xb, NULL, 0), SPH_OK);
                 free(xb);
                 CHECK_EQ_INT(sph_set_hydrostatic(&w), SPH_OK);
-                for (i = 0; i < w.n; ++i) e0 += (double)w.mass * g * (double)w.x[(size_t)D * i + 1];
+                for (i = 0; i < w.n; ++i)
+                    e0 += (double)w.mass * g * (double)w.x[(size_t)D * i + 1];
                 M = (double)w.mass * (double)w.n;
                 for (frame = 1; frame <= 25 && st == SPH_OK; ++frame) {
                     double e;
                     st = sph_advance(&w, (sph_real)0.02);
                     e = w.stats.kinetic_energy;
-                    for (i = 0; i < w.n; ++i) e += (double)w.mass * g * (double)w.x[(size_t)D * i + 1];
+                    for (i = 0; i < w.n; ++i)
+                        e += (double)w.mass * g * (double)w.x[(size_t)D * i + 1];
                     if (e - e0 > rise) rise = e - e0;
                 }
-                TH_NOTE("%-6s %dD tank in walls of one layer %.1f dx apart: %s at t = %.2f s, energy "
-                        "rise %.3g of M g H", solver_name(&def), D, s / dx,
-                        st == SPH_OK ? "ok" : w.error, w.time, rise / (M * g * H));
+                TH_NOTE(
+                    "%-6s %dD tank in walls of one layer %.1f dx apart: %s at t = %.2f s, energy "
+                    "rise %.3g of M g H",
+                    solver_name(&def), D, s / dx, st == SPH_OK ? "ok" : w.error, w.time,
+                    rise / (M * g * H));
                 CHECK_MSG(st == SPH_OK, "%s: %s", solver_name(&def), w.error);
                 CHECK_LE(rise, 0.005 * M * g * H);
                 sph_world_free(&w);
@@ -987,8 +995,10 @@ static void test_dense_host_walls(void) {
    same tank runs 0.1 s. Before, IISPH's 2D tank gained 16.7 M g H within 0.12 s, every frame
    SPH_OK, and threw particles out of the tank; DFSPH alike (16.4); PBF 0.13 M g H in 1 s. */
 static void test_crowded_placement_refused(void) {
-    static const int which[5][2] = {{SPH_SOLVER_IISPH, -1}, {SPH_SOLVER_DFSPH, -1},
-                                    {SPH_SOLVER_PBF, -1},   {SPH_SOLVER_PCISPH, 0},
+    static const int which[5][2] = {{SPH_SOLVER_IISPH, -1},
+                                    {SPH_SOLVER_DFSPH, -1},
+                                    {SPH_SOLVER_PBF, -1},
+                                    {SPH_SOLVER_PCISPH, 0},
                                     {SPH_SOLVER_PCISPH, 1}};
     int D, q, placed;
     for (D = 2; D <= 3; ++D)
@@ -999,7 +1009,8 @@ static void test_crowded_placement_refused(void) {
                 const double H = D == 2 ? 0.3 : 0.15;
                 sph_world_def def = sph_world_def_default(D);
                 sph_world w;
-                const sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)L[0], (sph_real)H, (sph_real)L[2]};
+                const sph_real lo[3] = {0, 0, 0},
+                               hi[3] = {(sph_real)L[0], (sph_real)H, (sph_real)L[2]};
                 const size_t nb = host_tank(D, o, dx, L, NULL);
                 sph_real* xb = (sph_real*)malloc(sizeof(sph_real) * (size_t)D * nb);
                 sph_real* x0;
@@ -1017,7 +1028,8 @@ static void test_crowded_placement_refused(void) {
                 memcpy(x0, w.x, w.n * (size_t)D * sizeof(sph_real));
                 st = sph_advance(&w, (sph_real)0.02);
                 if (!placed) {
-                    TH_NOTE("%-11s %dD walls on the fluid's faces: %s", solver_name(&def), D, w.error);
+                    TH_NOTE("%-11s %dD walls on the fluid's faces: %s", solver_name(&def), D,
+                            w.error);
                     CHECK_EQ_INT(st, SPH_ERR_ARG);
                     CHECK_MSG(strstr(w.error, "starts compressed") != NULL, "%s", w.error);
                     CHECK_NEAR(w.time, 0, 0);
