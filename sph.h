@@ -8028,8 +8028,8 @@ static sph_status sph__grid_kernel_sum(const sph_world* w, const sph_grid* g, co
     return s;
 }
 
-/* Two grids at the kernel's reach over the world's domain (the placement checks' fluid and walls);
-   on failure neither is left allocated. */
+/* Two grids at the kernel's reach over the world's domain (the free-surface check's fluid and
+   walls); on failure neither is left allocated. */
 static sph_status sph__grid_pair_init(const sph_world* w, sph_grid* ga, sph_grid* gb) {
     sph_status s = sph_grid_init(ga, w->dim, w->kernel.radius, w->def.periodic, w->def.domain_lo,
                                  w->def.domain_hi);
@@ -8040,9 +8040,9 @@ static sph_status sph__grid_pair_init(const sph_world* w, sph_grid* ga, sph_grid
     return s;
 }
 
-/* The volumes SPH_BVOL_AUTO or SPH_BVOL_AKINCI give walls just added (sph__stage_boundary_volume
-   and _auto, which run at the first sort), from the walls' own grid: so the checks below weigh a
-   wall sampled denser than the fluid as the step will. */
+/* The volumes SPH_BVOL_AUTO gives walls just added (sph__stage_boundary_volume_auto, which runs
+   at the first sort), from the walls' own grid: so the check below weighs a wall sampled denser
+   than the fluid as the step will. */
 static sph_status sph__placed_auto_volumes(const sph_world* w, const sph_grid* g, uint32_t** buf,
                                            size_t* cap, sph_real* vol) {
     const size_t D = (size_t)w->dim;
@@ -8058,9 +8058,10 @@ static sph_status sph__placed_auto_volumes(const sph_world* w, const sph_grid* g
             sum += (double)sph_kernel_w(&w->kernel, (sph_real)sqrt(r2));
             if ((*buf)[q] != b && r2 < near2) near2 = r2;
         }
-        vol[b] = (sph_real)((double)w->def.boundary_gamma * (double)w->priv.lattice_sum / sum);
-        if (w->def.boundary_volume == SPH_BVOL_AUTO)
-            vol[b] = sph__auto_volume(w->dim, w->b_vol[b], vol[b], (sph_real)near2);
+        vol[b] = sph__auto_volume(
+            w->dim, w->b_vol[b],
+            (sph_real)((double)w->def.boundary_gamma * (double)w->priv.lattice_sum / sum),
+            (sph_real)near2);
     }
     return SPH_OK;
 }
@@ -8073,71 +8074,39 @@ static sph_status sph__placed_auto_volumes(const sph_world* w, const sph_grid* g
    ("time step too large", a particle at 39 m/s) after every retry. Fluid closer to a wall than
    the lattice's spacing but short of its first layer is left to the wall contact. Only the fluid
    added since the last step is checked, unless walls were added: the walls are sorted into a
-   grid of their own (sph_grid) and each fluid particle queried, about a neighbour search.
-   Fluid crowded into walls or other fluid (check_walls; the incompressible solvers and PBF): a
-   newly placed fluid particle whose volume fraction of a full neighbourhood, (sum_j dx^dim W_ij +
-   sum_b V_b W_ib) / S over fluid and walls, is above SPH__PLACED_FILL starts compressed by as much,
-   and these solvers remove a compression within a step or a few, releasing it as motion (WCSPH
-   stores it in its equation of state and gives it back at the sound speed's pace; the
-   compressible step is for gases). Measured: a tank at rest (0.6 m wide, water 0.3 m deep) in
-   walls of one layer a host placed closer than a spacing to the fluid, IISPH through sph_advance,
-   frames of 0.02 s, every frame SPH_OK: walls on the fluid box's faces (0.5 dx from it; fraction
-   1.25 in 2D), energy up 16.7 M g H within 0.12 s and particles thrown out of the tank; 0.75 dx
-   away in 3D (1.26), 7.8 M g H within 0.08 s; 0.8 dx in 3D (1.20) 1.2 M g H. Below the bound
-   the release is smaller but not nothing (3D at 0.9 dx, 1.10: 0.12 M g H; 2D at 0.75 dx, 1.15:
-   0.46), and the tests' own scenes place fluid up to 1.13 (walls a host samples 1.5 dx apart, a
-   paddle placed into the fluid): SPH_ERR_ARG, named, the world unchanged. Only where the walls
-   overfill it (the fluid's own part below 1.01): fluid placed into fluid (an emitter onto a pool)
-   is pushed apart, both sides giving way (tests/test_hostile.c, fluid_added_into_fluid). */
-#define SPH__PLACED_FILL 1.2
-static sph_status sph__check_placed(sph_world* w, sph_solver solver) {
+   grid of their own (sph_grid) and each fluid particle queried, about a neighbour search. */
+static sph_status sph__check_placed(sph_world* w) {
     const size_t D = (size_t)w->dim;
-    const int walls = w->nb > 0 && w->def.boundary_volume != SPH_BVOL_AKINCI &&
-                      w->priv.wall_fraction_max > 0;
-    const int fill = sph__incompressible((int)solver); /* PBF included */
-    sph_grid g, gf;
+    sph_grid g;
     uint32_t* buf;
-    sph_real* vol = NULL; /* the default or Akinci's volumes of walls just added */
-    size_t cap = 256, i, bad = (size_t)-1, crowd = (size_t)-1;
-    double fbad = 0, fcrowd = 0, vdx = 1, sum = 0, sf = 0;
+    sph_real* vol = NULL; /* SPH_BVOL_AUTO's volumes of walls just added */
+    size_t cap = 256, i, bad = (size_t)-1;
+    double fbad = 0, sum = 0;
     sph_status s;
-    int k;
-    if (!w->def.check_walls || (!walls && !fill) || w->priv.placed_from >= w->n) return SPH_OK;
-    for (k = 0; k < w->dim; ++k) vdx *= (double)w->dx;
-    s = sph__grid_pair_init(w, &g, &gf);
-    if (s != SPH_OK)
-        return sph__fail(w, s, -1, "step: the placement check's grid: %s", sph_status_string(s));
+    if (!w->def.check_walls || w->nb == 0 || w->def.boundary_volume == SPH_BVOL_AKINCI ||
+        !(w->priv.wall_fraction_max > 0) || w->priv.placed_from >= w->n)
+        return SPH_OK;
+    s = sph_grid_init(&g, w->dim, w->kernel.radius, w->def.periodic, w->def.domain_lo,
+                      w->def.domain_hi);
+    if (s != SPH_OK) return sph__fail(w, s, -1, "step: the walls' grid: %s", sph_status_string(s));
     buf = (uint32_t*)SPH_MALLOC(cap * sizeof(uint32_t));
-    s = buf ? SPH_OK : SPH_ERR_NOMEM;
-    if (s == SPH_OK && fill) s = sph_grid_build(&gf, w->x, w->n);
-    if (s == SPH_OK && w->nb > 0) s = sph_grid_build(&g, w->b_x, w->nb);
-    if (s == SPH_OK && w->nb > 0 && w->def.boundary_volume != SPH_BVOL_GIVEN && w->priv.b_dirty) {
+    s = buf ? sph_grid_build(&g, w->b_x, w->nb) : SPH_ERR_NOMEM;
+    if (s == SPH_OK && w->def.boundary_volume == SPH_BVOL_AUTO && w->priv.b_dirty) {
         vol = (sph_real*)SPH_MALLOC(w->nb * sizeof(sph_real));
         s = vol ? sph__placed_auto_volumes(w, &g, &buf, &cap, vol) : SPH_ERR_NOMEM;
     }
     for (i = w->priv.placed_from; s == SPH_OK && i < w->n && bad == (size_t)-1; ++i) {
-        const sph_real* xi = w->x + i * D;
-        sum = sf = 0;
-        if (w->nb > 0)
-            s = sph__grid_kernel_sum(w, &g, w->b_x, vol ? vol : w->b_vol, 0, xi, &buf, &cap, &sum);
-        if (s == SPH_OK && fill)
-            s = sph__grid_kernel_sum(w, &gf, w->x, NULL, vdx, xi, &buf, &cap, &sf);
-        sum /= (double)w->priv.lattice_sum;
-        sf = sf / (double)w->priv.lattice_sum + sum;
-        if (s == SPH_OK && walls && sum > (double)w->priv.wall_fraction_max) {
+        s = sph__grid_kernel_sum(w, &g, w->b_x, vol ? vol : w->b_vol, 0, w->x + i * D, &buf, &cap,
+                                 &sum);
+        if (s == SPH_OK && sum / (double)w->priv.lattice_sum > (double)w->priv.wall_fraction_max) {
             bad = i;
-            fbad = sum;
-        } else if (s == SPH_OK && fill && sf > SPH__PLACED_FILL && sf - sum < 1.01 &&
-                   crowd == (size_t)-1) { /* the walls fill it up: the fluid alone does not */
-            crowd = i;
-            fcrowd = sf;
+            fbad = sum / (double)w->priv.lattice_sum;
         }
     }
     SPH_FREE(vol);
     SPH_FREE(buf);
     sph_grid_free(&g);
-    sph_grid_free(&gf);
-    if (s != SPH_OK) return sph__fail(w, s, -1, "step: out of memory (the placement check)");
+    if (s != SPH_OK) return sph__fail(w, s, -1, "step: out of memory (the walls' grid)");
     if (bad != (size_t)-1) {
         const sph_real* xb = w->x + bad * D;
         return sph__fail(w, SPH_ERR_ARG, (long)bad,
@@ -8147,17 +8116,6 @@ static sph_status sph__check_placed(sph_world* w, sph_solver solver) {
                          "the fluid?); remove it",
                          bad, (unsigned)w->id[bad], (double)xb[0], D > 1 ? (double)xb[1] : 0.0,
                          D > 2 ? (double)xb[2] : 0.0, fbad, (double)w->priv.wall_fraction_max);
-    }
-    if (crowd != (size_t)-1) {
-        const sph_real* xb = w->x + crowd * D;
-        return sph__fail(w, SPH_ERR_ARG, (long)crowd,
-                         "fluid particle %zu (id %u) at (%g, %g, %g) starts compressed: fluid and "
-                         "walls within its reach fill %g of a full neighbourhood (more than %g), "
-                         "so the step would release the compression as motion; fluid placed "
-                         "closer than a spacing to walls or to other fluid (walls on the faces "
-                         "of the fluid's box? place them half a spacing outside it)",
-                         crowd, (unsigned)w->id[crowd], (double)xb[0], D > 1 ? (double)xb[1] : 0.0,
-                         D > 2 ? (double)xb[2] : 0.0, fcrowd, SPH__PLACED_FILL);
     }
     return SPH_OK;
 }
@@ -8280,7 +8238,7 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
     s = sph__check_step_input(w, dt);
     if (s != SPH_OK) return s;
     if (w->priv.placed) { /* fluid or walls added since the last step */
-        s = sph__check_placed(w, solver);
+        s = sph__check_placed(w);
         if (s == SPH_OK) s = sph__check_free_surface(w);
         if (s != SPH_OK) return s;
         w->priv.placed = 0;

@@ -987,69 +987,11 @@ static void test_dense_host_walls(void) {
             }
 }
 
-/* Fluid crowded against walls: a tank of water at rest (as dense_host_walls, walls of one layer
-   at dx) whose walls the host placed on the faces of the fluid's box, half a spacing from the
-   fluid instead of a spacing (sph.h, sph__check_placed). IISPH, DFSPH, PBF and both PCISPH, 2D
-   and 3D: the first sph_advance refuses with SPH_ERR_ARG, "starts compressed", the world as it
-   was (time 0, positions not even sorted); with the walls half a spacing outside the box the
-   same tank runs 0.1 s. Before, IISPH's 2D tank gained 16.7 M g H within 0.12 s, every frame
-   SPH_OK, and threw particles out of the tank; DFSPH alike (16.4); PBF 0.13 M g H in 1 s. */
-static void test_crowded_placement_refused(void) {
-    static const int which[5][2] = {{SPH_SOLVER_IISPH, -1},
-                                    {SPH_SOLVER_DFSPH, -1},
-                                    {SPH_SOLVER_PBF, -1},
-                                    {SPH_SOLVER_PCISPH, 0},
-                                    {SPH_SOLVER_PCISPH, 1}};
-    int D, q, placed;
-    for (D = 2; D <= 3; ++D)
-        for (q = 0; q < 5; ++q)
-            for (placed = 0; placed < 2; ++placed) {
-                const double dx = D == 2 ? 0.02 : 0.03, o = placed ? 0.5 * dx : 0;
-                const double L[3] = {D == 2 ? 0.6 : 0.3, D == 2 ? 0.45 : 0.25, 0.15};
-                const double H = D == 2 ? 0.3 : 0.15;
-                sph_world_def def = sph_world_def_default(D);
-                sph_world w;
-                const sph_real lo[3] = {0, 0, 0},
-                               hi[3] = {(sph_real)L[0], (sph_real)H, (sph_real)L[2]};
-                const size_t nb = host_tank(D, o, dx, L, NULL);
-                sph_real* xb = (sph_real*)malloc(sizeof(sph_real) * (size_t)D * nb);
-                sph_real* x0;
-                sph_status st;
-                int frame;
-                if (which[q][1] >= 0) sph_world_def_pcisph(&def, which[q][1]);
-                def.solver = (sph_solver)which[q][0];
-                def.spacing = (sph_real)dx;
-                water_box(&w, &def, lo, hi);
-                host_tank(D, o, dx, L, xb);
-                CHECK_EQ_INT(sph_add_boundary(&w, nb, xb, NULL, 0), SPH_OK);
-                free(xb);
-                CHECK_EQ_INT(sph_set_hydrostatic(&w), SPH_OK);
-                x0 = (sph_real*)malloc(w.n * (size_t)D * sizeof(sph_real));
-                memcpy(x0, w.x, w.n * (size_t)D * sizeof(sph_real));
-                st = sph_advance(&w, (sph_real)0.02);
-                if (!placed) {
-                    TH_NOTE("%-11s %dD walls on the fluid's faces: %s", solver_name(&def), D,
-                            w.error);
-                    CHECK_EQ_INT(st, SPH_ERR_ARG);
-                    CHECK_MSG(strstr(w.error, "starts compressed") != NULL, "%s", w.error);
-                    CHECK_NEAR(w.time, 0, 0);
-                    CHECK(memcmp(x0, w.x, w.n * (size_t)D * sizeof(sph_real)) == 0);
-                } else {
-                    for (frame = 1; frame < 5 && st == SPH_OK; ++frame)
-                        st = sph_advance(&w, (sph_real)0.02);
-                    CHECK_MSG(st == SPH_OK, "%s %dD: %s", solver_name(&def), D, w.error);
-                }
-                free(x0);
-                sph_world_free(&w);
-            }
-}
-
 const th_test tests_reliability[] = {
     {"reliability/energy_check_gravity", test_energy_check_gravity},
     {"reliability/free_fall_not_a_runaway", test_free_fall_not_runaway},
     {"reliability/coarse_host_walls", test_coarse_host_walls},
     {"reliability/dense_host_walls", test_dense_host_walls},
-    {"reliability/crowded_placement_refused", test_crowded_placement_refused},
     {"reliability/slosh_confined", test_slosh_confined},
     {"reliability/stirrer_confined", test_stirrer_confined},
     {"reliability/momentum_periodic", test_momentum_periodic},
