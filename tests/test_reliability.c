@@ -931,7 +931,8 @@ static size_t host_tank(int D, double o, double s, const double* L, sph_real* xb
    sph_advance in 0.02 s frames for 0.5 s: every frame SPH_OK, no particle past the walls' line and
    the energy (kinetic + potential) never more than 0.5 % of M g H above its start. Each such
    particle used to keep dx^dim (the larger of the given volume and Akinci's), so the layer
-   weighed as walls sampled at dx several times over. Measured before: in 2D at 0.5 dx the energy rose 0.935 (IISPH), 0.927 (DFSPH) and
+   weighed as walls sampled at dx several times over. Measured before: in 2D at 0.5 dx the energy
+   rose 0.935 (IISPH), 0.927 (DFSPH) and
    0.041 (PBF) of M g H; with a rule that gave pairs closer than 0.7 dx Akinci's volume, the 3D
    tank at 0.8 dx still rose 1.80 (IISPH), 1.99 (DFSPH) and 0.157 (PBF) of M g H, the 2D one 0.042
    and 0.043, every frame SPH_OK, and at 0.5 dx the first step refused the 3D world ("inside the
