@@ -588,15 +588,15 @@ static void test_advance_stable_step(void) {
 
 /* The calibrated Akinci factor (def.boundary_gamma = 0, sph__akinci_gamma): a fluid lattice
    beside a flat single layer of wall particles with Akinci volumes has the rest density in its
-   first row (the summed density of a step's start: WCSPH's, as the incompressible solvers move
-   fluid placed compressed apart first), in 2D and 3D; with gamma = 1 that row was 15 %
-   compressed. The factor itself: 0.585 / 0.587 for Wendland C2 at h = 1.3 dx. Also with the
+   first row (the summed density of a step's start: the compressible step's, as the others move
+   fluid placed compressed against walls apart first), in 2D and 3D; with gamma = 1 that row was
+   15 % compressed. The factor itself: 0.585 / 0.587 for Wendland C2 at h = 1.3 dx. Also with the
    kernel IISPH gets by default in 3D (the cubic B-spline at h = dx, whose layer with gamma = 1
    overweighs less: 6 % against 15 %). The default volumes (SPH_BVOL_AUTO, g = 2)
    give the layer the same: the larger of dx^dim and Akinci's. */
 static void test_akinci_gamma(void) {
     int dim, g, kern;
-    for (kern = 0; kern < 2; ++kern) { /* Wendland C2; the automatic kernel (only 3D differs) */
+    for (kern = 0; kern < 2; ++kern) { /* Wendland C2; in 3D, the cubic B-spline at h = dx */
         for (dim = 2 + kern; dim <= 3; ++dim)
             for (g = 0; g < 3; ++g) {
                 sph_world_def d = sph_world_def_default(dim);
@@ -612,9 +612,9 @@ static void test_akinci_gamma(void) {
                 water.rest_density = 1000;
                 water.sound_speed = 20;
                 d.spacing = (sph_real)dx;
-                /* WCSPH with a summed density: a step reads the placed state as it is (the
-                   incompressible solvers first move fluid placed compressed apart) */
-                d.solver = SPH_SOLVER_WCSPH;
+                /* the compressible step with a summed density reads the placed state as it is
+                   (the other steps first move fluid placed compressed against walls apart) */
+                d.solver = SPH_SOLVER_COMPRESSIBLE;
                 d.density = SPH_DENSITY_SUMMATION;
                 d.gravity[1] = 0;
                 d.boundary_volume = g == 2 ? SPH_BVOL_AUTO : SPH_BVOL_AKINCI;
