@@ -925,6 +925,38 @@ static size_t host_tank(int D, double o, double s, const double* L, sph_real* xb
     return nb;
 }
 
+/* A tank at rest: water filling 0..L[0] x 0..H (x 0..L[2]) in host_tank's walls (o, s), from
+   sph_set_hydrostatic. */
+static void host_tank_world(sph_world* w, const sph_world_def* def, double o, double s,
+                            const double* L, double H) {
+    const int D = def->dim;
+    const sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)L[0], (sph_real)H, (sph_real)L[2]};
+    const size_t nb = host_tank(D, o, s, L, NULL);
+    sph_real* xb = (sph_real*)malloc(sizeof(sph_real) * (size_t)D * nb);
+    water_box(w, def, lo, hi);
+    host_tank(D, o, s, L, xb);
+    CHECK_EQ_INT(sph_add_boundary(w, nb, xb, NULL, 0), SPH_OK);
+    free(xb);
+    CHECK_EQ_INT(sph_set_hydrostatic(w), SPH_OK);
+}
+
+/* The kinetic and potential energy of a host tank's fluid [J], and (added to *out) its
+   particles past the walls' line (o outside the fluid's box). */
+static double host_tank_energy(const sph_world* w, double g, double o, const double* L,
+                               size_t* out) {
+    const int D = w->dim;
+    double e = w->stats.kinetic_energy;
+    size_t i;
+    int k;
+    for (i = 0; i < w->n; ++i) {
+        const sph_real* x = w->x + (size_t)D * i;
+        e += (double)w->mass * g * (double)x[1];
+        for (k = 0; k < D; ++k)
+            *out += (double)x[k] < -o || (k != 1 && (double)x[k] > L[k] + o);
+    }
+    return e;
+}
+
 /* Walls a host samples denser than the fluid. A tank at rest (2D: 0.6 m wide, water 0.3 m deep,
    dx 0.02; 3D: 0.3 x 0.15 m, 0.15 m deep, dx 0.03; sph_set_hydrostatic) in walls of one layer of
    boundary particles 0.5 dx or 0.8 dx apart (default volumes), IISPH, DFSPH and PBF through
@@ -951,37 +983,19 @@ static void test_dense_host_walls(void) {
                 const double H = D == 2 ? 0.3 : 0.15;
                 sph_world_def def = sph_world_def_default(D);
                 sph_world w;
-                const sph_real lo[3] = {0, 0, 0},
-                               hi[3] = {(sph_real)L[0], (sph_real)H, (sph_real)L[2]};
-                const size_t nb = host_tank(D, 0.5 * dx, s, L, NULL);
-                sph_real* xb = (sph_real*)malloc(sizeof(sph_real) * (size_t)D * nb);
-                size_t i;
                 sph_status st = SPH_OK;
-                double e0 = 0, rise = 0, M = 0;
+                double e0, rise = 0, M;
                 size_t out = 0;
                 int frame;
                 def.solver = solvers[q];
                 def.spacing = (sph_real)dx;
-                water_box(&w, &def, lo, hi);
-                host_tank(D, 0.5 * dx, s, L, xb);
-                CHECK_EQ_INT(sph_add_boundary(&w, nb, xb, NULL, 0), SPH_OK);
-                free(xb);
-                CHECK_EQ_INT(sph_set_hydrostatic(&w), SPH_OK);
-                for (i = 0; i < w.n; ++i)
-                    e0 += (double)w.mass * g * (double)w.x[(size_t)D * i + 1];
+                host_tank_world(&w, &def, 0.5 * dx, s, L, H);
+                e0 = host_tank_energy(&w, g, 0.5 * dx, L, &out);
                 M = (double)w.mass * (double)w.n;
                 for (frame = 1; frame <= 25 && st == SPH_OK; ++frame) {
                     double e;
                     st = sph_advance(&w, (sph_real)0.02);
-                    e = w.stats.kinetic_energy;
-                    for (i = 0; i < w.n; ++i) {
-                        const sph_real* x = w.x + (size_t)D * i;
-                        int k;
-                        e += (double)w.mass * g * (double)x[1];
-                        for (k = 0; k < D; ++k) /* past the walls' line, half a spacing out */
-                            out += (double)x[k] < -0.5 * dx ||
-                                   (k != 1 && (double)x[k] > L[k] + 0.5 * dx);
-                    }
+                    e = host_tank_energy(&w, g, 0.5 * dx, L, &out);
                     if (e - e0 > rise) rise = e - e0;
                 }
                 TH_NOTE(
@@ -1027,24 +1041,15 @@ static void test_placed_compressed(void) {
                 const double H = D == 2 ? 0.3 : 0.15;
                 sph_world_def def = sph_world_def_default(D);
                 sph_world w;
-                const sph_real lo[3] = {0, 0, 0},
-                               hi[3] = {(sph_real)L[0], (sph_real)H, (sph_real)L[2]};
-                const size_t nb = host_tank(D, o, dx, L, NULL);
-                sph_real* xb = (sph_real*)malloc(sizeof(sph_real) * (size_t)D * nb);
-                size_t i, out = 0;
+                size_t out = 0;
                 sph_status st = SPH_OK;
-                double e0 = 0, e1 = 0, rise = 0, rise1 = 0, M, lift, area = 1, floor;
+                double e0, e1 = 0, rise = 0, rise1 = 0, M, lift, area = 1, floor;
                 int frame, k;
                 if (q < 4) def.solver = solvers[q]; /* q = 5: WCSPH, the default */
                 if (q == 3 || q == 4) sph_world_def_pcisph(&def, q == 4);
                 def.spacing = (sph_real)dx;
-                water_box(&w, &def, lo, hi);
-                host_tank(D, o, dx, L, xb);
-                CHECK_EQ_INT(sph_add_boundary(&w, nb, xb, NULL, 0), SPH_OK);
-                free(xb);
-                CHECK_EQ_INT(sph_set_hydrostatic(&w), SPH_OK);
-                for (i = 0; i < w.n; ++i)
-                    e0 += (double)w.mass * g * (double)w.x[(size_t)D * i + 1];
+                host_tank_world(&w, &def, o, dx, L, H);
+                e0 = host_tank_energy(&w, g, o, L, &out);
                 M = (double)w.mass * (double)w.n;
                 /* the lift: the fluid's centre from H/2 to half the depth it has in the box
                    the walls leave, whose floor is half a spacing above the walls' line */
@@ -1055,13 +1060,7 @@ static void test_placed_compressed(void) {
                 for (frame = 1; frame <= 25 && st == SPH_OK; ++frame) {
                     double e;
                     st = sph_advance(&w, (sph_real)0.02);
-                    e = w.stats.kinetic_energy;
-                    for (i = 0; i < w.n; ++i) {
-                        const sph_real* x = w.x + (size_t)D * i;
-                        e += (double)w.mass * g * (double)x[1];
-                        for (k = 0; k < D; ++k) /* past the walls' line */
-                            out += (double)x[k] < -o || (k != 1 && (double)x[k] > L[k] + o);
-                    }
+                    e = host_tank_energy(&w, g, o, L, &out);
                     if (e - e0 > rise) rise = e - e0;
                     if (frame == 1) e1 = e;
                     else if (e - e1 > rise1) rise1 = e - e1;
