@@ -10722,38 +10722,37 @@ SPHDEF sph_status sph_step_pbf(sph_world* w, sph_real dt) {
 
 /* Fluid placed compressed. A host that puts its walls on the faces of the fluid's box (half a
    spacing from the fluid), or fills a box that reaches up to an obstacle or into other fluid,
-   starts the fluid denser than rest: rho/rho0 = 1.25 at the walls of a 2D tank (0.6 x 0.3 m,
-   dx 0.02, one host-placed wall layer on the box's faces), 1.46 at a 3D tank's corners. An
+   starts the fluid denser than rest: rho/rho0 = 1.25 at the walls of a 2D tank (0.6 x 0.3 m, dx
+   0.02, one host-placed wall layer on the box's faces), 1.46 at a 3D tank's corners. An
    incompressible step turns that compression into velocity within a step. Measured through
-   sph_advance with the defaults (tests/test_reliability.c, placed_compressed, the tank above
-   for 0.5 s): IISPH and DFSPH gained 20.1 and 19.2 M g H and threw particles out of the tank,
-   every call SPH_OK; both PCISPH failed the first call; with the walls a quarter spacing further
-   out IISPH still gained 0.57 M g H; in 3D every solver failed the first call or gained 4.6
-   M g H. Refusing such a start is no answer: a world rebuilt from a running simulation
-   (examples/realtime.c's solver switch) is a valid start with fluid as close to its walls.
-   So the first step after fluid or walls were added (one rest density; PCISPH, IISPH, DFSPH,
-   PBF, and WCSPH where a particle with walls in reach is compressed) moves the fluid apart
-   before time starts: Macklin & Mueller's (2013) position
-   projection, eqs. 1 and 9-14 (the walls fixed and mirroring each particle's multiplier, no
-   artificial pressure, C clamped to compression, eps = SPH__SETTLE_EPS of the lattice's
-   sum |grad C|^2), in positions only, the velocities, pressures and any carried density as they
-   were, until no particle is compressed by more than SPH__SETTLE_TO, at most
-   SPH__SETTLE_ITERATIONS projections. Each projection moves a particle at most SPH__SETTLE_MOVE
-   dx and is followed by the wall contact at SPH__SETTLE_WALL dx (sph__settle_contact, the
-   lattice's distance): without either, corner particles went through a layer of one wall
-   particle (2 of the 2D tank's 450). The lists are searched again whenever the largest moves
-   since the last search add up to SPH__SETTLE_RESEARCH dx: with the first lists kept to the
-   end, a 3D tank (0.6 x 0.3 x 0.3 m, dx 0.03) settled to 0.2 % by the projection's count was
-   32 % compressed by the step's. A start at most SPH__SETTLE_ABOVE compressed is left exactly
-   as it is (a lattice a spacing from lattice walls, a running incompressible solver's state:
-   then the stage costs a neighbour search and one pass). WCSPH and the compressible step are
-   compressible: fluid compressed away from walls is theirs to expand (tests/test_wcsph.c,
-   free_expansion_ballistic), and the compressible step keeps any start. But WCSPH's tank with
-   walls 0.8-0.9 dx from its fluid (compressed 3-6 % by them) rose 0.17-0.22 M g H by 2 s,
-   unreported, its kinetic energy growing from about 1 s on; settled, it holds. Measured on the
-   tanks above: 156 projections in 2D, 98-159 in 3D; the energy then rose by the lift of the
-   volume that did not fit and no more (every solver 0.048-0.050 M g H in 2D against 0.051
-   estimated, none after the first frame), no particle out (PBF in 3D aside: README, Limits). */
+   sph_advance with the defaults (tests/test_reliability.c, placed_compressed, the tank above for
+   0.5 s): IISPH and DFSPH gained 20.1 and 19.2 M g H and threw particles out of the tank, every
+   call SPH_OK; both PCISPH failed the first call; with the walls a quarter spacing further out
+   IISPH still gained 0.57 M g H; in 3D every solver failed the first call or gained 4.6 M g H.
+   Refusing such a start is no answer: a world rebuilt from a running simulation
+   (examples/realtime.c's solver switch) is a valid start with fluid as close to its walls. So the
+   first step after fluid or walls were added (one rest density; PCISPH, IISPH, DFSPH, PBF, and
+   WCSPH where a particle with walls in reach is compressed) moves the fluid apart before time
+   starts: Macklin & Mueller's (2013) position projection, eqs. 1 and 9-14 (the walls fixed and
+   mirroring each particle's multiplier, no artificial pressure, C clamped to compression, eps =
+   SPH__SETTLE_EPS of the lattice's sum |grad C|^2), in positions only, the velocities, pressures
+   and any carried density as they were, until no particle is compressed by more than
+   SPH__SETTLE_TO, at most SPH__SETTLE_ITERATIONS projections. Each projection moves a particle at
+   most SPH__SETTLE_MOVE dx and is followed by the wall contact at SPH__SETTLE_WALL dx
+   (sph__settle_contact, the lattice's distance): without either, corner particles went through a
+   layer of one wall particle (2 of the 2D tank's 450). The lists are searched again whenever the
+   largest moves since the last search add up to SPH__SETTLE_RESEARCH dx: with the first lists kept
+   to the end, a 3D tank (0.6 x 0.3 x 0.3 m, dx 0.03) settled to 0.2 % by the projection's count was
+   32 % compressed by the step's. A start at most SPH__SETTLE_ABOVE compressed is left exactly as it
+   is (a lattice a spacing from lattice walls, a running incompressible solver's state: then the
+   stage costs a neighbour search and one pass). WCSPH and the compressible step are compressible:
+   fluid compressed away from walls is theirs to expand (tests/test_wcsph.c,
+   free_expansion_ballistic), and the compressible step keeps any start. But WCSPH's tank with walls
+   0.8-0.9 dx from its fluid (compressed 3-6 % by them) rose 0.17-0.22 M g H by 2 s, unreported, its
+   kinetic energy growing from about 1 s on; settled, it holds. Measured on the tanks above: 156
+   projections in 2D, 98-159 in 3D; the energy then rose by the lift of the volume that did not fit
+   and no more (every solver 0.048-0.050 M g H in 2D against 0.051 estimated, none after the first
+   frame), no particle out (PBF in 3D aside: README, Limits). */
 #define SPH__SETTLE_ABOVE 0.01
 #define SPH__SETTLE_TO 0.002
 #define SPH__SETTLE_ITERATIONS 500
