@@ -1530,8 +1530,10 @@ SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, cons
    phase's mass and its back pressure. SPH_ERR_ARG (nothing added) for a bad phase, x NULL, a
    non-finite x or v, or a particle within 1e-3 spacings of another of x or of fluid already in
    the world (coincident particles never separate; closer than a spacing but not coincident is
-   accepted: IISPH and DFSPH push such overlaps apart, see def.max_compression); n = 0 does
-   nothing. Cost: a pass over the world's particles and a table of the n new ones. */
+   accepted: the next step first moves fluid that starts more than 1 % compressed apart, in
+   positions only: PCISPH, IISPH, DFSPH, PBF, and WCSPH where walls compress it, with one rest
+   density; sph__settle_placed); n = 0 does nothing. Cost: a pass over the world's particles and
+   a table of the n new ones. */
 SPHDEF sph_status sph_add_fluid(sph_world* w, int phase, size_t n, const sph_real* x,
                                 const sph_real* v);
 /* The same with a mass m[i] [kg] and a density rho[i] [kg/m^3] per particle (either NULL: the
@@ -1554,7 +1556,9 @@ SPHDEF sph_status sph_add_wall_box(sph_world* w, const sph_real* lo, const sph_r
                                    int layers, unsigned open_faces);
 /* Adds n boundary particles at x with volumes vol [m^dim] (NULL = dx^dim) and a body tag in
    [0, 65535], at rest, with b_x0 = x. SPH_ERR_ARG (nothing added) for x NULL, a non-finite x,
-   a vol[i] not finite and > 0 or a body out of range; n = 0 does nothing. */
+   a vol[i] not finite and > 0 or a body out of range; n = 0 does nothing. Fluid within a
+   spacing of the new walls starts compressed: the next step moves it apart first (see
+   sph_add_fluid); fluid inside their layers is refused by that step (def.check_walls). */
 SPHDEF sph_status sph_add_boundary(sph_world* w, size_t n, const sph_real* x, const sph_real* vol,
                                    int body);
 /* Sets density and pressure of all fluid particles to hydrostatic equilibrium under gravity, in
