@@ -5456,12 +5456,66 @@ static void sph__stage_boundary_volume_auto(sph_world* w) {
    sph_add_wall_box, dx 0.02): with the ramp there the original PCISPH sank a particle through
    the first layer at the corner of a 3D box of sph_add_wall_box (dx 0.04, at 0.16 s, reported
    by the tank check); as thin walls it holds. The crossing check (sph__wall_crossed) looks at
-   thin walls only, in 2D and 3D and with every solver. A point sampled twice (two wall
-   particles closer than half a spacing: where two faces a host sampled separately meet) counts
-   once in the sum: counted twice, the corner of a box of single layers 1.5 dx apart was not
-   thin, and PBF let 2 of 400 particles out through the hole it left in the check
-   (tests/test_reliability.c, coarse_host_walls). Static walls: once; moved walls: at every
-   sort (a rigid motion keeps the flags). */
+   thin walls, in 2D and 3D and with every solver. A point sampled twice (two wall particles
+   closer than half a spacing: where two faces a host sampled separately meet) counts once in
+   the sum: counted twice, the corner of a box of single layers 1.5 dx apart was not thin, and
+   PBF let 2 of 400 particles out through the hole it left in the check
+   (tests/test_reliability.c, coarse_host_walls).
+   The sum alone calls a layer thick wherever another wall is within the kernel's reach: near
+   the edges of a host's box and, in a small one, everywhere (a 3D tank 0.3 x 0.15 m at dx 0.03,
+   its faces sampled 0.92-0.95 dx apart: every point), and then PBF let 2 particles a frame out
+   through the hollows of a face (reliability/placed_compressed). So a point is thin as well
+   when its nearest others lie in one plane (a line in 2D; sph__wall_planar): those within 1.25
+   times the nearest one's distance (points sampled twice left out), whose second moment about
+   the point has its smallest eigenvalue below a tenth of its largest. A lattice wall's first
+   layer has the point behind it at the nearest distance (eigenvalues 1 : 2 : 2 in 3D); a face
+   next to another face a spacing below has that face's point at its own line (0 : 2 : 2); the
+   edge line where two faces meet stays thick (1 : 1 : 2). Static walls: once; moved walls: at
+   every sort (a rigid motion keeps the flags). */
+static int sph__wall_planar(const sph_world* w, size_t b) {
+    const int D = w->dim;
+    const sph_neighbors* nl = &w->priv.bb;
+    const sph_real dup2 = SPH__R(0.01) * w->dx * w->dx; /* a point sampled twice */
+    const size_t k0 = nl->begin[b], k1 = k0 + nl->count[b];
+    double s2 = 1e300, m[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}}, tr, lmin;
+    size_t kk;
+    int pass, k, j;
+    for (pass = 0; pass < 2; ++pass) /* the nearest other point's distance^2, then the moments */
+        for (kk = k0; kk < k1; ++kk) {
+            sph_real d[3] = {0, 0, 0}, r2 = 0;
+            sph_grid_delta(&w->priv.bgrid, w->b_x + b * (size_t)D,
+                           w->b_x + nl->idx[kk] * (size_t)D, d);
+            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+            if (r2 < dup2) continue;
+            if (pass == 0) {
+                if ((double)r2 < s2) s2 = (double)r2;
+            } else if ((double)r2 <= 1.5625 * s2) /* (1.25 s)^2 */
+                for (k = 0; k < D; ++k)
+                    for (j = 0; j < D; ++j) m[k][j] += (double)d[k] * (double)d[j];
+        }
+    tr = m[0][0] + m[1][1] + m[2][2];
+    if (!(tr > 0)) return 1; /* alone */
+    if (D == 2) {
+        const double h = 0.5 * (m[0][0] - m[1][1]);
+        lmin = 0.5 * tr - sqrt(h * h + m[0][1] * m[0][1]);
+        return lmin <= 0.1 * (tr - lmin);
+    } else { /* the smallest eigenvalue of the symmetric 3 x 3 (trigonometric form) */
+        const double q = tr / 3;
+        const double p1 = m[0][1] * m[0][1] + m[0][2] * m[0][2] + m[1][2] * m[1][2];
+        const double a = m[0][0] - q, c = m[1][1] - q, e = m[2][2] - q;
+        const double p = sqrt((a * a + c * c + e * e + 2 * p1) / 6);
+        double r, phi, lmax;
+        if (!(p > 0)) return 0; /* isotropic */
+        r = (a * (c * e - m[1][2] * m[1][2]) - m[0][1] * (m[0][1] * e - m[1][2] * m[0][2]) +
+             m[0][2] * (m[0][1] * m[1][2] - c * m[0][2])) /
+            (2 * p * p * p);
+        phi = r <= -1 ? 3.14159265358979 / 3 : r >= 1 ? 0 : acos(r) / 3;
+        lmax = q + 2 * p * cos(phi);
+        lmin = q + 2 * p * cos(phi + 2 * 3.14159265358979 / 3);
+        return lmin <= 0.1 * lmax;
+    }
+}
+
 static void sph__wall_thin(sph_world* w) {
     const int akinci = w->def.boundary_volume == SPH_BVOL_AKINCI;
     sph__idx b;
@@ -5469,7 +5523,8 @@ static void sph__wall_thin(sph_world* w) {
     for (b = 0; b < (sph__idx)w->nb; ++b)
         w->priv.b_thin[b] =
             (uint8_t)(akinci ||
-                      (double)sph__wall_kernel_sum_of(w, (size_t)b, 1) < w->priv.thin_sum);
+                      (double)sph__wall_kernel_sum_of(w, (size_t)b, 1) < w->priv.thin_sum ||
+                      sph__wall_planar(w, (size_t)b));
     w->priv.b_thin_on = 1;
 }
 
@@ -6974,111 +7029,153 @@ static int sph__wall_cross_guard(const sph__ctx* c, size_t i, const sph_real* xo
    - walls a callback moves: putting a particle back where the step found it, against walls that
      moved since, let one particle out of the turning drums of tests/test_scenes.c (drum_2d:
      IISPH and DFSPH; drum_3d: DFSPH and PBF) at 3.2-3.4 sqrt(g H): static walls only.
-   Thick walls are left to check_walls. Returns 1 if it acted. */
-#define SPH__CROSS_NEAR 6 /* wall particles the crossing check looks at (4 in 2D) */
+   Where a thin wall ends next to a thick one (a host's one-layer slope whose last points stop a
+   spacing above a floor of sph_add_wall_box, 1.5-1.7 dx from the floor's first layer) the gap
+   between them is closed by neither: the contact's push off the floor leaves out the slope's end
+   ahead of it, and the slope's last points are thick by their kernel sums. So the planes that D
+   of the SPH__CROSS_NEAR nearest thin particles span come first, then those with the
+   SPH__CROSS_THICK nearest thick ones (at least one thin in each; in 3D, one thin and two thick
+   only where a thick one lies within 1.25 dx of the thin one: the edge of a thin wall counted
+   thick), and the particle is looked at when the nearest of either is within 1.1 dx. Not kept:
+   one thin with any two thick. A plane through two points of a thick wall's first layer and a
+   thin point beyond cut into that wall's contact zone, where fluid rests: a particle beside a
+   3D slope's junction with a box's side was sent back every step while the solver sped it up
+   (DFSPH, frozen at one place from 0.33 s, 40 m/s and failed at 0.94 s). Measured, a column
+   running down such a slope (reliability/slope_junction, 1 s, every frame SPH_OK), particles more
+   than 2 dx under the slope, most in a frame, before -> after: 2D box (dx 0.02) IISPH 5, PBF 4,
+   original PCISPH 3 -> 0 (DFSPH and WCSPH 0); 3D channel periodic in z (dx 0.03) IISPH 35,
+   DFSPH 27, PBF 33, original PCISPH 17 -> 0. In a 3D box the corner where the slope's end, the
+   floor and a side wall meet is all thick (README, Limits): 27, 20, 24, 21 -> 1, 0, 0, 1.
+   Walls of thick layers only are left to check_walls. Returns 1 if it acted. */
+#define SPH__CROSS_NEAR 6  /* thin wall particles the crossing check looks at (4 in 2D) */
+#define SPH__CROSS_THICK 6 /* and thick ones, where a thin wall meets a thick one (2 in 2D) */
 static int sph__wall_crossed(const sph__ctx* c, size_t i, const uint8_t* thin, const sph_real* xs,
                              sph_real lead, sph_real lead_s, sph_real dx, sph_real* xi,
                              sph_real* vi) {
-    const int D = c->dim, K = D == 3 ? SPH__CROSS_NEAR : 4;
+    const int D = c->dim, K = D == 3 ? SPH__CROSS_NEAR : 4, KT = D == 3 ? SPH__CROSS_THICK : 2;
     const size_t k0 = c->fb->begin[i], k1 = k0 + c->fb->count[i];
     const sph_real side2 = SPH__R(5.0625) * dx * dx; /* (2.25 dx)^2 */
-    sph_real r2n[SPH__CROSS_NEAR], dn[SPH__CROSS_NEAR][3];
-    size_t bn[SPH__CROSS_NEAR], kk;
-    int k, j, m = 0, v[3];
+    const sph_real near2 = SPH__R(1.5625) * dx * dx; /* (1.25 dx)^2 */
+    /* the K nearest thin wall particles, nearest first, then the KT nearest thick ones */
+    sph_real r2n[SPH__CROSS_NEAR + SPH__CROSS_THICK], dn[SPH__CROSS_NEAR + SPH__CROSS_THICK][3];
+    size_t bn[SPH__CROSS_NEAR + SPH__CROSS_THICK], kk;
+    int k, j, t, m = 0, mt = 0, v[3], mixed;
     if (D < 2) return 0;
-    for (kk = k0; kk < k1; ++kk) { /* the K nearest thin wall particles, nearest first */
-        const size_t b = c->fb->idx[kk];
-        sph_real d[3] = {0, 0, 0}, r2 = 0;
-        if (!thin[b]) continue;
-        sph__wall_delta(c, xi, b, lead, d);
-        for (k = 0; k < D; ++k) r2 += d[k] * d[k];
-        if (m == K && !(r2 < r2n[K - 1])) continue;
-        for (j = m < K ? m : K - 1; j > 0 && r2 < r2n[j - 1]; --j) { /* insert at j */
-            r2n[j] = r2n[j - 1];
-            bn[j] = bn[j - 1];
-            for (k = 0; k < 3; ++k) dn[j][k] = dn[j - 1][k];
-        }
-        r2n[j] = r2;
-        bn[j] = b;
-        for (k = 0; k < 3; ++k) dn[j][k] = d[k];
-        if (m < K) ++m;
-    }
-    if (m < D || !(r2n[0] < SPH__R(1.21) * dx * dx)) return 0;
-    /* every D of them (v[0] < v[1] < v[2]), nearest first */
-    for (v[0] = 0; v[0] < m; ++v[0])
-        for (v[1] = v[0] + 1; v[1] < m; ++v[1])
-            for (v[2] = D == 3 ? v[1] + 1 : 0; v[2] < (D == 3 ? m : 1); ++v[2]) {
-                sph_real e1[3] = {0, 0, 0}, e2[3] = {0, 0, 0}, nrm[3] = {0, 0, 0};
-                sph_real ds[3] = {0, 0, 0}, q[3], a11 = 0, a12 = 0, a22 = 0, b1 = 0, b2 = 0;
-                sph_real ss = 0, se = 0, n2 = 0, vn = 0, u, al, be;
-                const sph_real* vb;
-                /* the sides from the first: x_b' - x_b = d - d' (d = x_e - x_b); the normal */
-                for (k = 0; k < D; ++k) {
-                    e1[k] = dn[v[0]][k] - dn[v[1]][k];
-                    if (D == 3) e2[k] = dn[v[0]][k] - dn[v[2]][k];
-                }
-                if (D == 2) {
-                    nrm[0] = -e1[1];
-                    nrm[1] = e1[0];
-                } else {
-                    nrm[0] = e1[1] * e2[2] - e1[2] * e2[1];
-                    nrm[1] = e1[2] * e2[0] - e1[0] * e2[2];
-                    nrm[2] = e1[0] * e2[1] - e1[1] * e2[0];
-                }
-                for (k = 0; k < D; ++k) {
-                    a11 += e1[k] * e1[k];
-                    a12 += e1[k] * e2[k];
-                    a22 += e2[k] * e2[k];
-                    n2 += nrm[k] * nrm[k];
-                }
-                /* wall particles of one layer lie close together (sampled at up to 1.5 dx) */
-                if (!(a11 <= side2) || !(n2 > 0)) continue;
-                if (D == 3) { /* the other sides; three nearly in a line span no plane */
-                    sph_real e3 = 0;
-                    for (k = 0; k < 3; ++k) e3 += (e1[k] - e2[k]) * (e1[k] - e2[k]);
-                    if (!(a22 <= side2) || !(e3 <= side2) || !(n2 > SPH__R(0.03) * a11 * a22))
-                        continue;
-                }
-                sph__wall_delta(c, xs, bn[v[0]], lead_s, ds);
-                for (k = 0; k < D; ++k) {
-                    ss += ds[k] * nrm[k];
-                    se += dn[v[0]][k] * nrm[k];
-                }
-                /* the same side at both ends, or not behind it at the end */
-                if (!(ss * se < 0) && !(ss == 0 && se != 0)) continue;
-                if (ss < 0 || (ss == 0 && se > 0)) {
-                    for (k = 0; k < D; ++k) nrm[k] = -nrm[k];
-                    ss = -ss;
-                    se = -se;
-                }
-                /* the end's foot on the plane, from the first, within the widened triangle */
-                for (k = 0; k < D; ++k) {
-                    q[k] = dn[v[0]][k] - se / n2 * nrm[k];
-                    b1 += q[k] * e1[k];
-                    b2 += q[k] * e2[k];
-                }
-                if (D == 2) {
-                    al = b1 / a11;
-                    if (!(al >= SPH__R(-0.25) && al <= SPH__R(1.25))) continue;
-                } else {
-                    const sph_real det = a11 * a22 - a12 * a12;
-                    al = (b1 * a22 - b2 * a12) / det;
-                    be = (b2 * a11 - b1 * a12) / det;
-                    if (!(al >= SPH__R(-0.25) && be >= SPH__R(-0.25) && al + be <= SPH__R(1.25)))
-                        continue;
-                }
-                /* back to the start, without the velocity into the wall (relative to its
-                   nearest particle) */
-                vb = c->bv + bn[0] * (size_t)D;
-                u = 1 / sph__sqrt(n2);
-                for (k = 0; k < D; ++k) {
-                    xi[k] = xs[k];
-                    vn += (vi[k] - vb[k]) * nrm[k] * u;
-                }
-                if (vn < 0)
-                    for (k = 0; k < D; ++k) vi[k] -= vn * nrm[k] * u;
-                return 1;
+    for (t = 1; t >= 0 && (t || m > 0); --t) /* the thin ones, then (near a thin one) the thick */
+        for (kk = k0; kk < k1; ++kk) {
+            const size_t b = c->fb->idx[kk];
+            const int o = t ? 0 : K, cap = t ? K : KT;
+            int* cnt = t ? &m : &mt;
+            sph_real d[3] = {0, 0, 0}, r2 = 0;
+            if ((thin[b] != 0) != t) continue;
+            sph__wall_delta(c, xi, b, lead, d);
+            for (k = 0; k < D; ++k) r2 += d[k] * d[k];
+            if (*cnt == cap && !(r2 < r2n[o + cap - 1])) continue;
+            for (j = *cnt < cap ? *cnt : cap - 1; j > 0 && r2 < r2n[o + j - 1]; --j) {
+                r2n[o + j] = r2n[o + j - 1]; /* insert at j */
+                bn[o + j] = bn[o + j - 1];
+                for (k = 0; k < 3; ++k) dn[o + j][k] = dn[o + j - 1][k];
             }
+            r2n[o + j] = r2;
+            bn[o + j] = b;
+            for (k = 0; k < 3; ++k) dn[o + j][k] = d[k];
+            if (*cnt < cap) ++*cnt;
+        }
+    /* a thin wall particle among them, and the nearest of either within 1.1 dx */
+    if (m < 1 || !(r2n[0] < SPH__R(1.21) * dx * dx || (mt > 0 && r2n[K] < SPH__R(1.21) * dx * dx)))
+        return 0;
+    if (m < K) /* the thick ones next to the thin ones */
+        for (j = 0; j < mt; ++j) {
+            r2n[m + j] = r2n[K + j];
+            bn[m + j] = bn[K + j];
+            for (k = 0; k < 3; ++k) dn[m + j][k] = dn[K + j][k];
+        }
+    /* every D of them (v[0] < v[1] < v[2]), nearest first: first the thin walls' own planes,
+       then those of a thin wall's particles with a thick wall's (v[0] thin, the last thick) */
+    for (mixed = 0; mixed < (mt > 0 ? 2 : 1); ++mixed)
+        for (v[0] = 0; v[0] < m; ++v[0])
+            for (v[1] = v[0] + 1; v[1] < (mixed ? m + mt : m); ++v[1])
+                for (v[2] = D == 3 ? v[1] + 1 : 0; v[2] < (D == 3 ? (mixed ? m + mt : m) : 1);
+                     ++v[2]) {
+                    sph_real e1[3] = {0, 0, 0}, e2[3] = {0, 0, 0}, nrm[3] = {0, 0, 0};
+                    sph_real ds[3] = {0, 0, 0}, q[3], a11 = 0, a12 = 0, a22 = 0, b1 = 0, b2 = 0;
+                    sph_real ss = 0, se = 0, n2 = 0, vn = 0, u, al, be;
+                    const sph_real* vb;
+                    if (mixed != (v[D - 1] >= m)) continue; /* each tuple in its round */
+                    /* the sides from the first: x_b' - x_b = d - d' (d = x_e - x_b); the normal */
+                    for (k = 0; k < D; ++k) {
+                        e1[k] = dn[v[0]][k] - dn[v[1]][k];
+                        if (D == 3) e2[k] = dn[v[0]][k] - dn[v[2]][k];
+                    }
+                    if (D == 2) {
+                        nrm[0] = -e1[1];
+                        nrm[1] = e1[0];
+                    } else {
+                        nrm[0] = e1[1] * e2[2] - e1[2] * e2[1];
+                        nrm[1] = e1[2] * e2[0] - e1[0] * e2[2];
+                        nrm[2] = e1[0] * e2[1] - e1[1] * e2[0];
+                    }
+                    for (k = 0; k < D; ++k) {
+                        a11 += e1[k] * e1[k];
+                        a12 += e1[k] * e2[k];
+                        a22 += e2[k] * e2[k];
+                        n2 += nrm[k] * nrm[k];
+                    }
+                    /* wall particles of one layer lie close together (sampled at up to 1.5 dx) */
+                    if (!(a11 <= side2) || !(n2 > 0)) continue;
+                    if (D == 3) { /* the other sides; three nearly in a line span no plane */
+                        sph_real e3 = 0;
+                        for (k = 0; k < 3; ++k) e3 += (e1[k] - e2[k]) * (e1[k] - e2[k]);
+                        if (!(a22 <= side2) || !(e3 <= side2) || !(n2 > SPH__R(0.03) * a11 * a22))
+                            continue;
+                        /* one thin and two thick: one of the thick a neighbour of the thin one
+                           along its wall (a thin wall's edge counted thick); a plane through two
+                           points of a thick wall's layer and a thin point further off cuts into
+                           the thick wall's contact zone, where fluid rests, and held a particle
+                           there while the solver sped it up (a 3D slope against a box's side) */
+                        if (mixed && v[1] >= m && !(a11 <= near2) && !(a22 <= near2)) continue;
+                    }
+                    sph__wall_delta(c, xs, bn[v[0]], lead_s, ds);
+                    for (k = 0; k < D; ++k) {
+                        ss += ds[k] * nrm[k];
+                        se += dn[v[0]][k] * nrm[k];
+                    }
+                    /* the same side at both ends, or not behind it at the end */
+                    if (!(ss * se < 0) && !(ss == 0 && se != 0)) continue;
+                    if (ss < 0 || (ss == 0 && se > 0)) {
+                        for (k = 0; k < D; ++k) nrm[k] = -nrm[k];
+                        ss = -ss;
+                        se = -se;
+                    }
+                    /* the end's foot on the plane, from the first, within the widened triangle */
+                    for (k = 0; k < D; ++k) {
+                        q[k] = dn[v[0]][k] - se / n2 * nrm[k];
+                        b1 += q[k] * e1[k];
+                        b2 += q[k] * e2[k];
+                    }
+                    if (D == 2) {
+                        al = b1 / a11;
+                        if (!(al >= SPH__R(-0.25) && al <= SPH__R(1.25))) continue;
+                    } else {
+                        const sph_real det = a11 * a22 - a12 * a12;
+                        al = (b1 * a22 - b2 * a12) / det;
+                        be = (b2 * a11 - b1 * a12) / det;
+                        if (!(al >= SPH__R(-0.25) && be >= SPH__R(-0.25) &&
+                              al + be <= SPH__R(1.25)))
+                            continue;
+                    }
+                    /* back to the start, without the velocity into the wall (relative to its
+                       nearest particle) */
+                    vb = c->bv + bn[0] * (size_t)D;
+                    u = 1 / sph__sqrt(n2);
+                    for (k = 0; k < D; ++k) {
+                        xi[k] = xs[k];
+                        vn += (vi[k] - vb[k]) * nrm[k] * u;
+                    }
+                    if (vn < 0)
+                        for (k = 0; k < D; ++k) vi[k] -= vn * nrm[k] * u;
+                    return 1;
+                }
     return 0;
 }
 
