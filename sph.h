@@ -10899,22 +10899,6 @@ static void sph__settle_contact(sph_world* w, const sph__ctx* c, const sph_real*
     }
 }
 
-/* The largest move between two position arrays [m] (serial: the same for any thread count). */
-static double sph__max_move(const sph_world* w, const sph_real* xa, const sph_real* xb) {
-    const size_t D = (size_t)w->dim;
-    double m2 = 0;
-    size_t i, k;
-    for (i = 0; i < w->n; ++i) {
-        double r2 = 0;
-        for (k = 0; k < D; ++k) {
-            const double d = (double)xb[i * D + k] - (double)xa[i * D + k];
-            r2 += d * d;
-        }
-        m2 = r2 > m2 ? r2 : m2;
-    }
-    return sqrt(m2);
-}
-
 /* Lists at the positions in w->x, and the projection's constants and scratch for them. The
    projections write their densities to w->rho, which a step that carries the density (WCSPH,
    enhanced PCISPH) keeps: it is kept in w->priv.ap meanwhile (sorted with the particles). */
@@ -10971,7 +10955,7 @@ static sph_status sph__settle_placed(sph_world* w, int walls_only) {
             break;
         sph__pbf_project(w, &c, &P);
         if (c.has_b) sph__settle_contact(w, &c, xa, xb);
-        moved += sph__max_move(w, xa, xb);
+        moved += (double)sph__sqrt(sph__max_shift2(&w->priv.grid, xb, xa, w->n));
         xa = xb;
         xb = xb == w->priv.xp ? w->priv.vp : w->priv.xp;
     }
