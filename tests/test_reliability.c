@@ -1027,7 +1027,7 @@ static void test_dense_host_walls(void) {
    dx: IISPH and DFSPH rose 4.6 M g H, WCSPH 0.40 (0.007 after the first frame), the others failed.
    PBF in 3D with o = 0.25 dx let 2-4 particles a frame out through the hollows of a side face from
    0.34 s on (48 particle-frames by 0.5 s): every point of that small tank's faces was a thick wall
-   by its kernel sum (sph__wall_thin); now the faces' points are thin (sph__wall_planar). */
+   by its kernel sum (sph__wall_thin); now the faces' points are thin (sph__wall_thin_of). */
 static void test_placed_compressed(void) {
     static const sph_solver solvers[4] = {SPH_SOLVER_IISPH, SPH_SOLVER_DFSPH, SPH_SOLVER_PBF,
                                           SPH_SOLVER_PCISPH};
