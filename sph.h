@@ -5469,14 +5469,15 @@ static void sph__stage_boundary_volume_auto(sph_world* w) {
    or there are none: in 2D the smallest eigenvalue of their second moment about the point is
    below a tenth of the largest, in 3D its determinant over its second invariant (the smallest
    eigenvalue while that is small) below 0.05 of its trace (eigenvalues 0.11 : 2 : 2, a layer
-   curved round a radius of three spacings, are thin; 0.3 : 2 : 2 thick). A lattice wall's first layer has the point behind it a spacing away
-   (eigenvalues 1 : 2 : 2 in 3D); a face next to another face a spacing below has that face's
-   point at its own line (0 : 2 : 2); the edge line where two faces meet stays thick (1 : 1 : 2).
-   Static walls only (where the crossing check looks): the flags of walls a callback moves are
-   computed again at every sort, and the moments made a 3D box of sph_add_wall_box moved so
-   1.08 times slower per step (IISPH, 2250 fluid and 6504 wall particles; 1.37 with a pass of
-   their own), so those keep the sum's rule. Static walls: once; moved walls: at every sort (a
-   rigid motion keeps the flags). */
+   curved round a radius of three spacings, are thin; 0.3 : 2 : 2 thick). A lattice wall's first
+   layer has the point behind it a spacing away (eigenvalues 1 : 2 : 2 in 3D); a face next to
+   another face a spacing below has that face's point at its own line (0 : 2 : 2); the edge line
+   where two faces meet stays thick (1 : 1 : 2). Static walls only (where the crossing check
+   looks): the flags of walls a callback moves are computed again at every sort, and the moments
+   made a run with a 3D box of sph_add_wall_box moved so take 1.08 times the CPU time (IISPH,
+   2250 fluid and 6504 wall particles, 0.2 s; 1.37 with a pass of their own), so those keep the
+   sum's rule. Static walls: once; moved walls: at every sort (a rigid motion keeps the
+   flags). */
 static int sph__wall_thin_of(const sph_world* w, size_t b, int planar) {
     const int D = w->dim;
     const sph_neighbors* nl = &w->priv.bb;
