@@ -5339,12 +5339,11 @@ static sph_status sph__wall_lists(sph_world* w, sph_real radius) {
     return SPH_OK;
 }
 
-/* sum_b' W_bb' / norm_w over wall particle b's wall neighbours, b itself included; with
-   `once`, a neighbour closer than half a spacing (the same point sampled twice) is left out. */
-static sph_real sph__wall_kernel_sum_of(const sph_world* w, size_t b, int once) {
+/* sum_b' W_bb' / norm_w over wall particle b's wall neighbours, b itself included (the thin
+   walls' sum, which counts a point sampled twice once, is sph__wall_thin_of's). */
+static sph_real sph__wall_kernel_sum(const sph_world* w, size_t b) {
     const int D = w->dim;
     const sph_neighbors* nl = &w->priv.bb;
-    const sph_real near2 = once ? SPH__R(0.25) * w->dx * w->dx : 0;
     size_t kk, k0 = nl->begin[b], k1 = k0 + nl->count[b];
     sph_real sum = sph__kw(w->kernel.form, 0);
     for (kk = k0; kk < k1; ++kk) {
@@ -5353,13 +5352,9 @@ static sph_real sph__wall_kernel_sum_of(const sph_world* w, size_t b, int once) 
         int k;
         sph_grid_delta(&w->priv.bgrid, w->b_x + b * (size_t)D, w->b_x + q * (size_t)D, d);
         for (k = 0; k < D; ++k) r2 += d[k] * d[k];
-        if (r2 < near2) continue;
         sum += sph__kw(w->kernel.form, sph__sqrt(r2) * w->kernel.inv_h);
     }
     return sum;
-}
-static sph_real sph__wall_kernel_sum(const sph_world* w, size_t b) {
-    return sph__wall_kernel_sum_of(w, b, 0);
 }
 
 /* Akinci et al. 2012 (Meiers 2025 eq. 27): a wall particle's volume is gamma_1 over its number
