@@ -8357,8 +8357,7 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
         /* an incompressible solver uses c0 only to scale artificial viscosity and the speed
            bound of the blow-up check: without one, both are off */
         if (solver == SPH_SOLVER_WCSPH || solver == SPH_SOLVER_COMPRESSIBLE) return s;
-        w->status = SPH_OK;
-        w->error[0] = 0;
+        s = SPH_OK; /* the step goes on: a begin without settling returns this */
     }
     for (k = 0; k < SPH_STAGE_COUNT; ++k) w->stats.stage_time[k] = 0;
     w->stats.step_time = 0;

@@ -1210,6 +1210,52 @@ static void test_sound_speed_follows_added_fluid(void) {
     }
 }
 
+/* An incompressible solver needs no sound speed: a block of water at rest with no gravity, no
+   walls, viscosity 0.01 m^2/s and sound_speed = 0 (nothing to derive c0 from), IISPH, original PCISPH, DFSPH and PBF,
+   2D (dx 0.02) and 3D (dx 0.04), 10 steps of sph_step at sph_stable_dt, then 0.1 s of
+   sph_advance. Every call returns SPH_OK with an empty w.error, and the block stays at rest.
+   Before, the step that did not settle the start (the second) kept the failed derivation's
+   SPH_ERR_ARG as its result with the message wiped (found by tests/fuzz_world.c). */
+static void test_incompressible_without_sound_speed(void) {
+    static const sph_solver solvers[4] = {SPH_SOLVER_IISPH, SPH_SOLVER_PCISPH, SPH_SOLVER_DFSPH,
+                                          SPH_SOLVER_PBF};
+    int dim, k, step;
+    for (dim = 2; dim <= 3; ++dim)
+        for (k = 0; k < 4; ++k) {
+            const double dx = dim == 2 ? 0.02 : 0.04;
+            sph_world_def d = sph_world_def_default(dim);
+            sph_world w;
+            sph_phase water;
+            const sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)0.2, (sph_real)0.2, (sph_real)0.2};
+            sph_status s = SPH_OK;
+            if (solvers[k] == SPH_SOLVER_PCISPH) sph_world_def_pcisph(&d, 0);
+            d.solver = solvers[k];
+            d.spacing = (sph_real)dx;
+            d.gravity[1] = 0;
+            memset(&water, 0, sizeof water);
+            water.rest_density = 1000;
+            water.viscosity = (sph_real)0.01; /* the one thing that limits the step here */
+            CHECK(sph_world_init(&w, &d) == SPH_OK && sph_world_add_phase(&w, &water) == 0 &&
+                  sph_fill_box(&w, 0, lo, hi) == SPH_OK);
+            for (step = 0; step < 10 && s == SPH_OK; ++step) {
+                const sph_real dt = sph_stable_dt(&w, solvers[k]);
+                CHECK_MSG(dt > 0 && w.error[0] == 0, "sph_stable_dt: %g, '%s'", (double)dt, w.error);
+                s = sph_step(&w, dt);
+                CHECK_MSG(s == SPH_OK, "%dD solver %d, step %d: %s '%s'", dim, (int)solvers[k], step,
+                          sph_status_string(s), w.error);
+            }
+            if (s == SPH_OK) s = sph_advance(&w, (sph_real)0.1);
+            CHECK_MSG(s == SPH_OK, "%dD solver %d, sph_advance: %s '%s'", dim, (int)solvers[k],
+                      sph_status_string(s), w.error);
+            CHECK_EQ_INT(w.status, SPH_OK);
+            CHECK(w.error[0] == 0);
+            CHECK_LT(w.stats.v_max, 1e-3);
+            TH_NOTE("%dD solver %d: t = %.3f s, %d steps, largest speed %.2g m/s", dim,
+                    (int)solvers[k], w.time, (int)w.steps, (double)w.stats.v_max);
+            sph_world_free(&w);
+        }
+}
+
 /* SPH_PGRAD_DIFFERENCE at a free surface: a tank at rest (0.4 m wide, 0.3 m of water in a box of
    sph_add_wall_box, 0.6 m high, WCSPH's defaults but this gradient), 2D (dx 0.02) and 3D (dx
    0.04). The form takes no pressure from the empty side, so the rows under the surface sink:
@@ -1263,6 +1309,7 @@ static void test_difference_free_surface(void) {
 const th_test tests_hostile[] = {
     {"hostile/difference_gradient_free_surface_refused", test_difference_free_surface},
     {"hostile/sound_speed_follows_added_fluid", test_sound_speed_follows_added_fluid},
+    {"hostile/incompressible_without_sound_speed", test_incompressible_without_sound_speed},
     {"hostile/summed_density_phase_ratio", test_summed_density_phase_ratio},
     {"hostile/fluid_inside_walls_refused", test_fluid_inside_walls},
     {"hostile/fluid_added_into_fluid", test_fluid_added_into_fluid},
