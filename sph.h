@@ -3881,6 +3881,13 @@ SPHDEF sph_status sph_world_init(sph_world* w, const sph_world_def* def) {
                         w->dx * sph__sqrt((sph_real)(i * i + j * j + l * l)) < w->kernel.radius)
                         ++w->priv.full_count;
     }
+    if (w->priv.full_count == 0) /* PCISPH's factor was 1/0 and its first pressure NaN */
+        return sph__fail(w, SPH_ERR_ARG, -1,
+                         "sph_world_def.h_factor = %g: the kernel's support (radius %g m) holds "
+                         "no neighbour of a lattice at def.spacing = %g m, so every particle is "
+                         "alone; h_factor must be above %g for this kernel",
+                         (double)hf, (double)w->kernel.radius, (double)def->spacing,
+                         (double)(hf * def->spacing / w->kernel.radius));
     sph__contact_ramp(w);
     /* the automatic Jacobi weight (sph_world_def.omega): lambda_max of D^-1 A grows with the
        neighbourhood (2.6 with 20 neighbours, 5.4-5.7 with 72 once disordered), and relaxed

@@ -79,6 +79,7 @@ static void test_def_fields(void) {
         {"dim", 0, 0},          {"dim", 0, 4},           {"spacing", 1, 0},
         {"spacing", 1, -0.01},  {"spacing", 1, NAN},     {"spacing", 1, INFINITY},
         {"h_factor", 2, -1},    {"h_factor", 2, 101},    {"h_factor", 2, NAN},
+        {"h_factor", 2, 0.5}, /* a support of one spacing: no lattice neighbour in reach */
         {"kernel", 3, 99},      {"kernel", 3, -2},       {"gravity", 4, NAN},
         {"gravity", 4, INFINITY}, {"solver", 5, 7},      {"density", 6, 9},
         {"pressure_grad", 7, 5}, {"integrator", 8, 5},   {"wall", 9, 5},
