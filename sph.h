@@ -2925,7 +2925,9 @@ SPHDEF sph_status sph_neighbors_build(sph_neighbors* nl, const sph_grid* g, cons
         size_t i = 0;
         while (i < g->n && g->order[i] == (uint32_t)i) ++i;
         if (i == g->n) return sph__neighbors_build(nl, g, x, NULL, xq, nq, radius, exclude_self);
-        if (exclude_self && xq != x) /* a copy of the grid's points, not in cell order either */
+        /* exclude_self names a point by its index: queries other than the grid's whole set in
+           its own array (a copy, or the first nq points) go through the permutation */
+        if (exclude_self && !(xq == x && nq == g->n))
             return sph__neighbors_build(nl, g, x, g->order, xq, nq, radius, exclude_self);
         return sph__neighbors_build_sorted(nl, g, x, xq, nq, radius, exclude_self);
     }

@@ -438,8 +438,8 @@ static void test_clamped(void) {
 
 /* Verifies neighbour lists nl (built over grid points x[0..n) for queries q[0..nq)) against the
    brute force: each list as a set, self excluded iff exclude_self, total = sum of counts, lists
-   inside idx and pairwise disjoint; with exclude_self also symmetric (j in list(i) iff i in
-   list(j)). */
+   inside idx and pairwise disjoint; with exclude_self also symmetric among the queries (j in
+   list(i) iff i in list(j)). */
 static void tg_check_lists(const char* what, const sph_neighbors* nl, const tg_bf* b,
                            const sph_real* x, size_t n, const sph_real* q, size_t nq,
                            sph_real radius, int exclude_self) {
@@ -472,7 +472,8 @@ static void tg_check_lists(const char* what, const sph_neighbors* nl, const tg_b
             for (l = 0; l < m; ++l) {
                 size_t j = nl->idx[nl->begin[i] + l], t;
                 int back = 0;
-                if (j >= nq || nl->begin[j] + nl->count[j] > nl->cap_idx) {
+                if (j >= nq) continue; /* not a query (the first nq points): no list */
+                if (nl->begin[j] + nl->count[j] > nl->cap_idx) {
                     ++asym;
                     break;
                 }
@@ -570,6 +571,11 @@ static void test_neighbors_build(void) {
     TH_NOTE("2D n %lu: %.1f neighbours per point, %.1f after compression", (unsigned long)n,
             (double)total0 / (double)n, (double)nl.total / (double)n);
     CHECK_LT(5 * total0, nl.total);
+    /* the first 500 of the grid's own points as queries, not in cell order */
+    CHECK_EQ_INT(sph_neighbors_build(&nl, &g, x, x, 500, (sph_real)cell, 1), SPH_OK);
+    tg_check_lists("2D first 500", &nl, &b2, x, n, x, 500, (sph_real)cell, 1);
+    CHECK_EQ_INT(sph_neighbors_build(&nl, &g, x, x, 500, (sph_real)cell, 0), SPH_OK);
+    tg_check_lists("2D first 500, self included", &nl, &b2, x, n, x, 500, (sph_real)cell, 0);
     /* fewer points */
     CHECK_EQ_INT(sph_grid_build(&g, x, 700), SPH_OK);
     CHECK_EQ_INT(sph_neighbors_build(&nl, &g, x, x, 700, (sph_real)cell, 1), SPH_OK);
