@@ -779,15 +779,13 @@ typedef struct sph_neighbors {
     size_t* chunk_cap;
     size_t* chunk_need;
     sph_real* xs;        /* points not in cell order: a copy in the grid's order [n * dim]    */
-    size_t* sbegin;      /* and the rows' begin and count, per query in that order [n]        */
-    uint32_t* scount;
-    size_t cap_xs, cap_s;
+    size_t cap_xs;
 } sph_neighbors;
 
 /* Builds the lists of all grid points within radius of each query point xq[i*dim + k].
    x is the array the grid was built on. exclude_self: xq is that same point set, and a point is
    not listed as its own neighbour. Points in any order: those not in the grid's cell order are
-   searched through a copy in that order (n * dim more reals in nl), 3.5-6 times faster than
+   searched through a copy in that order (n * dim more reals in nl), 3-6 times faster than
    through the grid's permutation. Memory is reused between builds and grows only when needed.
    SPH_ERR_ARG for radius not in (0, g->cell] or a NULL array; SPH_ERR_NOMEM (the lists are then
    empty, n = 0, until a build succeeds). */
@@ -2866,50 +2864,45 @@ static sph_status sph__grid_near(const sph_grid* g, uint8_t** near, size_t* cap,
 /* sph_neighbors_build for points the host keeps in any order (2D, 100k random points, ~21
    neighbours, 1 thread: 765 ns a point through the permutation, 148 for the same points in cell
    order). The points are copied in the grid's order (xs[k] = x[order[k]]) and searched in place
-   (the dense path where the grid has one); with xq == x the queries are taken in that order too,
-   so that a query's stencil is read from cache. Then every index is mapped back (order[j]) and,
-   for queries taken in cell order, every row's begin and count put at its query's index. The
-   lists hold the same pairs as the search through the permutation. */
+   (the dense path where the grid has one), for the queries in the host's order, so that each
+   row lies where a search through the permutation puts it (taking the queries in cell order as
+   well was 4 % slower in the second-order scheme's steps, whose loops then read the rows out of
+   order). Then every index is mapped back (order[j]), and with exclude_self the query's own
+   point is dropped (it is the point of the same index). The lists hold the same pairs as the
+   search through the permutation. */
 static sph_status sph__neighbors_build_sorted(sph_neighbors* nl, const sph_grid* g,
                                               const sph_real* x, const sph_real* xq, size_t nq,
                                               sph_real radius, int exclude_self) {
     const size_t n = g->n, D = (size_t)g->dim;
-    const int self = xq == x && nq == n;
     const uint32_t* order = g->order;
+    size_t total = 0;
     sph_status s;
     sph__idx k;
     if (n * D > nl->cap_xs) {
         if (!sph__grow((void**)&nl->xs, n * D, sizeof(sph_real))) return sph__neighbors_nomem(nl);
         nl->cap_xs = n * D;
     }
-    if (self && n > nl->cap_s) {
-        if (!sph__grow((void**)&nl->sbegin, n, sizeof(size_t)) ||
-            !sph__grow((void**)&nl->scount, n, sizeof(uint32_t)))
-            return sph__neighbors_nomem(nl);
-        nl->cap_s = n;
-    }
     SPH__OMP_FOR(n)
     for (k = 0; k < (sph__idx)n; ++k) {
         size_t d;
         for (d = 0; d < D; ++d) nl->xs[(size_t)k * D + d] = x[(size_t)order[k] * D + d];
     }
-    s = sph__neighbors_build(nl, g, nl->xs, NULL, self ? nl->xs : xq, nq, radius, exclude_self);
+    s = sph__neighbors_build(nl, g, nl->xs, NULL, xq, nq, radius, 0);
     if (s != SPH_OK) return s;
     SPH__OMP_FOR(nq)
     for (k = 0; k < (sph__idx)nq; ++k) {
         uint32_t* row = nl->idx + nl->begin[k];
-        uint32_t l;
-        for (l = 0; l < nl->count[k]; ++l) row[l] = order[row[l]];
-    }
-    if (self) {
-        SPH__OMP_FOR(n)
-        for (k = 0; k < (sph__idx)n; ++k) {
-            nl->sbegin[order[k]] = nl->begin[k];
-            nl->scount[order[k]] = nl->count[k];
+        uint32_t l, m = 0;
+        for (l = 0; l < nl->count[k]; ++l) {
+            const uint32_t j = order[row[l]];
+            row[m] = j;
+            m += !(exclude_self && j == (uint32_t)k);
         }
-        sph__copy(nl->begin, nl->sbegin, n * sizeof(size_t));
-        sph__copy(nl->count, nl->scount, n * sizeof(uint32_t));
+        nl->count[k] = m;
     }
+    if (exclude_self)
+        for (k = 0; k < (sph__idx)nq; ++k) total += nl->count[k];
+    if (exclude_self) nl->total = total;
     return SPH_OK;
 }
 
@@ -2925,10 +2918,6 @@ SPHDEF sph_status sph_neighbors_build(sph_neighbors* nl, const sph_grid* g, cons
         size_t i = 0;
         while (i < g->n && g->order[i] == (uint32_t)i) ++i;
         if (i == g->n) return sph__neighbors_build(nl, g, x, NULL, xq, nq, radius, exclude_self);
-        /* exclude_self names a point by its index: queries other than the grid's whole set in
-           its own array (a copy, or the first nq points) go through the permutation */
-        if (exclude_self && !(xq == x && nq == g->n))
-            return sph__neighbors_build(nl, g, x, g->order, xq, nq, radius, exclude_self);
         return sph__neighbors_build_sorted(nl, g, x, xq, nq, radius, exclude_self);
     }
 }
@@ -3184,8 +3173,6 @@ SPHDEF void sph_neighbors_free(sph_neighbors* nl) {
     SPH_FREE(nl->chunk_cap);
     SPH_FREE(nl->chunk_need);
     SPH_FREE(nl->xs);
-    SPH_FREE(nl->sbegin);
-    SPH_FREE(nl->scount);
     memset(nl, 0, sizeof(*nl));
 }
 
@@ -4721,7 +4708,7 @@ static size_t sph__grid_memory(const sph_grid* g) {
 
 static size_t sph__neighbors_memory(const sph_neighbors* nl) {
     return nl->cap_n * (sizeof(size_t) + sizeof(uint32_t)) + nl->cap_idx * sizeof(uint32_t) +
-           nl->cap_chunk * 4 * sizeof(size_t);
+           nl->cap_chunk * 4 * sizeof(size_t) + nl->cap_xs * sizeof(sph_real);
 }
 
 SPHDEF size_t sph_world_memory(const sph_world* w) {
