@@ -2900,9 +2900,10 @@ static sph_status sph__neighbors_build_sorted(sph_neighbors* nl, const sph_grid*
         }
         nl->count[k] = m;
     }
-    if (exclude_self)
+    if (exclude_self) { /* one entry fewer in most rows */
         for (k = 0; k < (sph__idx)nq; ++k) total += nl->count[k];
-    if (exclude_self) nl->total = total;
+        nl->total = total;
+    }
     return SPH_OK;
 }
 
