@@ -1538,7 +1538,10 @@ SPHDEF sph_status sph_fill_box(sph_world* w, int phase, const sph_real* lo, cons
    the world (coincident particles never separate; closer than a spacing but not coincident is
    accepted: the next step first moves fluid that starts more than 1 % compressed apart, in
    positions only: PCISPH, IISPH, DFSPH, PBF, and WCSPH where walls compress it, with one rest
-   density; sph__settle_placed); n = 0 does nothing. Cost: a pass over the world's particles and
+   density; sph__settle_placed). Those solvers' next step refuses fluid placed denser than rest
+   in bulk (SPH_ERR_ARG, the world unchanged: most particles away from walls more than 5 %
+   compressed, as a lattice closer than def.spacing gives; set sph_phase.mass to the particles'
+   share of the volume); n = 0 does nothing. Cost: a pass over the world's particles and
    a table of the n new ones. */
 SPHDEF sph_status sph_add_fluid(sph_world* w, int phase, size_t n, const sph_real* x,
                                 const sph_real* v);
@@ -8351,6 +8354,8 @@ static sph_status sph__check_free_surface(sph_world* w) {
 static int sph__settles(const sph_world* w, sph_solver solver);
 static sph_status sph__settle_placed(sph_world* w, int walls_only);
 static sph_status sph__snapshot_take(sph_world* w, int slot);
+static void sph__snapshot_restore(sph_world* w, int slot);
+static long sph__restore_named(sph_world* w, int slot);
 static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) {
     sph_status s;
     int k, settle = 0;
@@ -8430,7 +8435,15 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
     w->status = SPH_OK;
     w->priv.solver = (int)solver;
     if (settle) { /* fluid placed compressed moved apart before time starts (sph__settle_placed) */
+        /* a start it refuses is put back as it was: sph_advance restores its own copy, a bare
+           sph_step this one (the settling sorts and moves the particles) */
+        const int keep = settle == 1 && w->priv.settle_snap == 0;
+        if (keep && (s = sph__snapshot_take(w, 0)) != SPH_OK) {
+            w->priv.placed = 1;
+            return s;
+        }
         s = sph__settle_placed(w, settle == 2);
+        if (s == SPH_ERR_ARG && keep) sph__restore_named(w, 0);
         if (s != SPH_OK) w->priv.placed = 1; /* checked and settled again by the next attempt */
         /* sph_advance retries a failed first sub-step from here, not from before the settling
            (the same positions again, 500 projections each): a call whose 13 attempts failed took
@@ -10979,6 +10992,37 @@ static sph_status sph__settle_lists(sph_world* w, sph__ctx* c, sph__pbf* P) {
     return SPH_OK;
 }
 
+/* Fluid placed denser than rest in bulk (the incompressible solvers' settling only): more than
+   half of the fluid particles without walls in reach compressed by more than SPH__SETTLE_BULK,
+   as a lattice at a spacing below def.spacing gives (each particle carries rest_density *
+   spacing^dim: a lattice at 0.97 spacing is 6.3 % compressed in 2D, a hexagonal one at the
+   spacing 15.5 %). That is not an overlap to move apart but more mass than the volume holds:
+   the projection moves only what borders a free surface or a wall (a 2D block of 100 x 50
+   particles at 0.97 spacing in a tank of its width, 500 projections: the mean compression 5.5 ->
+   0.8 %, the largest 6 -> 4.8 %), and the step turned the rest into motion, unreported (IISPH:
+   0.11 M g H gained within 0.05 s, 0.59 sqrt(g H); at 0.95 spacing every retry failed with a
+   speed). So such a start is refused (SPH_ERR_ARG) with the compression and the particle named.
+   Returns that particle's index, or -1. */
+#define SPH__SETTLE_BULK 0.05
+static long sph__bulk_compressed(const sph_world* w, const sph__ctx* c, double* mean) {
+    size_t i, away = 0, over = 0;
+    long first = -1;
+    double sum = 0;
+    for (i = 0; i < w->n; ++i) {
+        double e;
+        if (c->has_b && c->fb->count[i] > 0) continue;
+        e = (double)w->rho[i] * (double)c->pc[c->ph[i]].inv_rho0 - 1;
+        ++away;
+        if (e > SPH__SETTLE_BULK) {
+            if (first < 0) first = (long)i;
+            ++over;
+            sum += e;
+        }
+    }
+    *mean = over ? sum / (double)over : 0;
+    return 2 * over > away ? first : -1;
+}
+
 static sph_status sph__settle_placed(sph_world* w, int walls_only) {
     const size_t nD = w->n * (size_t)w->dim;
     sph_real *xa = w->x, *xb;
@@ -11007,6 +11051,26 @@ static sph_status sph__settle_placed(sph_world* w, int walls_only) {
         P.x = xa;
         P.xo = xb;
         sph__pbf_lambdas(w, &c, &P);
+        if (it == 0 && !walls_only) {
+            double mean;
+            const long bad = sph__bulk_compressed(w, &c, &mean);
+            if (bad >= 0) {
+                const sph_real* xq = w->x + (size_t)bad * (size_t)w->dim;
+                sph__copy(w->rho, w->priv.ap, w->n * sizeof(sph_real));
+                return sph__fail(
+                    w, SPH_ERR_ARG, bad,
+                    "the fluid starts denser than its rest density in bulk: most particles away "
+                    "from walls are compressed by more than %g %% (on average %.3g %%; the "
+                    "first is the fluid particle with id %u at (%g, %g, %g)). Each particle "
+                    "carries rest_density * spacing^dim (spacing %g m): particles placed closer "
+                    "than def.spacing (a hexagonal lattice at the spacing is 15.5 %% denser in "
+                    "2D) hold more mass than their volume; place them at def.spacing or set "
+                    "sph_phase.mass",
+                    100 * SPH__SETTLE_BULK, 100 * mean, (unsigned)w->id[bad], (double)xq[0],
+                    w->dim > 1 ? (double)xq[1] : 0.0, w->dim > 2 ? (double)xq[2] : 0.0,
+                    (double)w->dx);
+            }
+        }
         if (sph__max_compression(w, &c, it == 0 && walls_only) <=
                 (it == 0 ? SPH__SETTLE_ABOVE : SPH__SETTLE_TO) ||
             it == SPH__SETTLE_ITERATIONS)
@@ -11312,6 +11376,26 @@ static sph_status sph__snapshot_take(sph_world* w, int slot) {
     return SPH_OK;
 }
 
+/* sph__snapshot_restore after a failure that names a particle in w->error_index: the failing
+   step may have re-sorted the particles, so the named one is found again by its id in the
+   restored order (fluid or boundary, as the message says). Returns the index (-1: none). */
+static long sph__restore_named(sph_world* w, int slot) {
+    long idx = w->error_index;
+    const int boundary = strstr(w->error, "boundary particle") != NULL &&
+                         strstr(w->error, "fluid particle") == NULL;
+    const size_t count = boundary ? w->nb : w->n;
+    const uint32_t id = idx >= 0 && (size_t)idx < count ? (boundary ? w->b_id : w->id)[idx] : 0;
+    sph__snapshot_restore(w, slot);
+    if (idx >= 0 && (size_t)idx < count) {
+        const uint32_t* now = boundary ? w->b_id : w->id;
+        size_t q;
+        for (q = 0; q < count && now[q] != id; ++q) {}
+        idx = q < count ? (long)q : -1;
+    }
+    w->error_index = idx;
+    return idx;
+}
+
 /* Puts the world back, bit for bit, to the state of sph__snapshot_take(slot). */
 static void sph__snapshot_restore(sph_world* w, int slot) {
     sph__array arr[32];
@@ -11479,25 +11563,12 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
         }
         {
             char msg[SPH_ERROR_SIZE];
-            long idx = w->error_index;
+            long idx;
             const double factor = 0.5 * fmin(w->stats.dt_factor, dt / dt_stable);
-            /* the failing step may have re-sorted the particles: keep the named one by its id,
-               to find it in the restored order (fluid or boundary, as the message says) */
-            const int boundary = strstr(w->error, "boundary particle") != NULL &&
-                                 strstr(w->error, "fluid particle") == NULL;
-            const size_t count = boundary ? w->nb : w->n;
-            const uint32_t* ids = boundary ? w->b_id : w->id;
-            const uint32_t id = idx >= 0 && (size_t)idx < count ? ids[idx] : 0;
             const int early = placed && w->steps - steps0 <= 10; /* within 10 steps of the adding */
             double t;
             memcpy(msg, w->error, sizeof msg);
-            sph__snapshot_restore(w, 0);
-            if (idx >= 0 && (size_t)idx < count) {
-                const uint32_t* now = boundary ? w->b_id : w->id;
-                size_t q;
-                for (q = 0; q < count && now[q] != id; ++q) {}
-                idx = q < count ? (long)q : -1;
-            }
+            idx = sph__restore_named(w, 0);
             w->stats.substeps = substeps;
             w->stats.retries = retries;
             w->stats.iterations_sum = iterations;

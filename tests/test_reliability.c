@@ -1087,6 +1087,101 @@ static void test_placed_compressed(void) {
             }
 }
 
+/* Fluid placed denser than rest in bulk: a host's lattice at 0.97 of def.spacing (each particle
+   still carries rest_density * spacing^dim: 6.3 % compressed in 2D, 9.6 % in 3D) filling the
+   floor of a tank of sph_add_wall_box (2D: 30 x 15 particles, dx 0.02; 3D: 12 x 7 x 7, dx 0.03),
+   with every incompressible solver: sph_advance and a bare sph_step refuse it with SPH_ERR_ARG
+   and the world as before (a hash of the state). Measured before (2D, 100 x 50 particles, dx
+   0.01, IISPH): 500 projections of the settling moved the mean compression from 5.5 to 0.8 %
+   and the rest became motion, 0.11 M g H gained within 0.05 s, every call SPH_OK. The same
+   lattice with sph_phase.mass set to its true share (rest_density (0.97 dx)^dim) is a tank at
+   rest: 0.12 s through sph_advance, every frame SPH_OK, no particle past the walls' first layer,
+   the energy never more than 0.5 % of M g H above its start. WCSPH, compressible, expands
+   such a start and is not refused. */
+static void test_placed_denser_than_rest(void) {
+    static const sph_solver solvers[6] = {SPH_SOLVER_IISPH,  SPH_SOLVER_DFSPH, SPH_SOLVER_PBF,
+                                          SPH_SOLVER_PCISPH, SPH_SOLVER_PCISPH, SPH_SOLVER_WCSPH};
+    const double g = 9.81, f = 0.97;
+    int D, q, massed;
+    for (D = 2; D <= 3; ++D)
+        for (q = 0; q < 6; ++q)
+            for (massed = 0; massed < 2; ++massed) {
+                const double dx = D == 2 ? 0.02 : 0.03, s = f * dx;
+                const int nx = D == 2 ? 30 : 12, ny = D == 2 ? 15 : 7, nz = D == 2 ? 1 : 7;
+                const double L[3] = {nx * s, 2 * ny * s, nz * s};
+                sph_world_def def = sph_world_def_default(D);
+                sph_world w;
+                sph_phase water;
+                sph_real *x = (sph_real*)malloc(sizeof(sph_real) * 3 * (size_t)(nx * ny * nz));
+                sph_real lo[3] = {0, 0, 0}, hi[3];
+                size_t n = 0, out = 0, i;
+                sph_status st;
+                double e0 = 0, rise = 0, M, H = ny * s;
+                int a, b, c, k, frame;
+                if (q == 5 && massed) { /* WCSPH: only the compressed start */
+                    free(x);
+                    continue;
+                }
+                def.solver = solvers[q];
+                if (q == 3 || q == 4) sph_world_def_pcisph(&def, q == 4);
+                def.spacing = (sph_real)dx;
+                memset(&water, 0, sizeof water);
+                water.rest_density = 1000;
+                if (massed) water.mass = (sph_real)(1000 * pow(s, D));
+                for (k = 0; k < D; ++k) hi[k] = (sph_real)L[k];
+                for (a = 0; a < nx; ++a)
+                    for (b = 0; b < ny; ++b)
+                        for (c = 0; c < nz; ++c, ++n) {
+                            const int ijk[3] = {a, b, c};
+                            for (k = 0; k < D; ++k)
+                                x[n * (size_t)D + (size_t)k] = (sph_real)((ijk[k] + 0.5) * s);
+                        }
+                CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
+                CHECK(sph_world_add_phase(&w, &water) == 0);
+                CHECK_EQ_INT(sph_add_fluid(&w, 0, n, x, NULL), SPH_OK);
+                CHECK_EQ_INT(sph_add_wall_box(&w, lo, hi, 0, 0), SPH_OK);
+                free(x);
+                if (!massed && q != 5) {
+                    const uint64_t h0 = th_state_hash(&w);
+                    st = sph_advance(&w, (sph_real)0.02);
+                    TH_NOTE("%-11s %dD lattice at %.2f dx: %s", solver_name(&def), D, f, w.error);
+                    CHECK_EQ_INT(st, SPH_ERR_ARG);
+                    CHECK_MSG(strstr(w.error, "denser than its rest density") != NULL, "%s",
+                              w.error);
+                    CHECK(th_state_hash(&w) == h0 && w.steps == 0);
+                    st = sph_step(&w, sph_stable_dt(&w, def.solver));
+                    CHECK_EQ_INT(st, SPH_ERR_ARG);
+                    CHECK(th_state_hash(&w) == h0 && w.steps == 0);
+                    sph_world_free(&w);
+                    continue;
+                }
+                M = (double)w.mass * (double)w.n;
+                for (i = 0; i < w.n; ++i) e0 += (double)w.mass * g * (double)w.x[i * (size_t)D + 1];
+                for (frame = 1, st = SPH_OK; frame <= 6 && st == SPH_OK; ++frame) {
+                    double e = w.stats.kinetic_energy;
+                    st = sph_advance(&w, (sph_real)0.02);
+                    e = w.stats.kinetic_energy;
+                    for (i = 0; i < w.n; ++i) {
+                        const sph_real* xi = w.x + i * (size_t)D;
+                        e += (double)w.mass * g * (double)xi[1];
+                        for (k = 0; k < D; ++k)
+                            out += (double)xi[k] < -0.5 * dx ||
+                                   (k != 1 && (double)xi[k] > L[k] + 0.5 * dx);
+                    }
+                    if (e - e0 > rise) rise = e - e0;
+                }
+                TH_NOTE("%-11s %dD lattice at %.2f dx, mass %s: %s at t = %.2f s, energy rise "
+                        "%.4f of M g H",
+                        solver_name(&def), D, f, massed ? "of its share" : "rho0 dx^dim",
+                        st == SPH_OK ? "ok" : w.error, w.time,
+                        rise / (M * g * H));
+                CHECK_MSG(st == SPH_OK, "%s: %s", solver_name(&def), w.error);
+                if (q != 5) CHECK_LE(rise, 0.005 * M * g * H);
+                CHECK_EQ_INT(out, 0);
+                sph_world_free(&w);
+            }
+}
+
 /* A one-layer slope a host samples into a box of sph_add_wall_box (thick walls): the slope
    falls at 30 degrees from the left wall at half the box's height, lattice points along it a
    spacing apart, and stops where the next point would lie less than 0.9 dx above the floor's
@@ -1194,6 +1289,7 @@ const th_test tests_reliability[] = {
     {"reliability/coarse_host_walls", test_coarse_host_walls},
     {"reliability/dense_host_walls", test_dense_host_walls},
     {"reliability/placed_compressed", test_placed_compressed},
+    {"reliability/placed_denser_than_rest", test_placed_denser_than_rest},
     {"reliability/slope_junction", test_slope_junction},
     {"reliability/slosh_confined", test_slosh_confined},
     {"reliability/stirrer_confined", test_stirrer_confined},
