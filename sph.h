@@ -1423,7 +1423,8 @@ typedef struct sph__private {
     int placed;                     /* fluid or walls added since the last step began
                                        (sph__check_placed)                                      */
     int settle_snap;                /* sph_advance's first sub-step: 1 asks the step to keep its
-                                       settled start in snap[1], 2 says it did (sph__settle_placed) */
+                                       settled start in snap[1], 2 says it did (sph__settle_placed);
+                                       3 a later sub-step; 0 a bare sph_step                      */
     size_t placed_from;             /* the first fluid index added since (0 once walls were)     */
     sph_real tank_lo[3], tank_hi[3]; /* check_walls: the inner faces of the closed box of
                                        sph_add_wall_box (sph__tank_check) [m]                    */
@@ -1579,8 +1580,8 @@ SPHDEF sph_status sph_add_boundary(sph_world* w, size_t n, const sph_real* x, co
 SPHDEF sph_status sph_set_hydrostatic(sph_world* w);
 /* The message of the last error (empty if none). */
 SPHDEF const char* sph_world_error(const sph_world* w);
-/* Bytes the world has allocated: particle arrays (at their capacity), grids, neighbour lists
-   and scratch. */
+/* Bytes the world has allocated: particle arrays (at their capacity), grids, neighbour lists,
+   scratch and sph_advance's copies of the state to roll back to. */
 SPHDEF size_t sph_world_memory(const sph_world* w);
 /* Total fluid mass [kg] and linear momentum [kg m/s] (out[dim]). */
 SPHDEF double sph_world_mass(const sph_world* w);
@@ -4742,6 +4743,7 @@ SPHDEF size_t sph_world_memory(const sph_world* w) {
               w->priv.vp_cap + w->priv.de_cap + w->priv.cs_cap + w->priv.vn_cap + w->priv.bpq_cap + w->priv.soc_cap + w->priv.socw_cap +
               w->priv.lapc_cap + w->priv.wg_cap + w->priv.abody_cap) *
                  sizeof(sph_real);
+    bytes += w->priv.snap_cap[0] + w->priv.snap_cap[1]; /* sph_advance's rollback copies */
     return bytes;
 }
 
@@ -8436,14 +8438,19 @@ static sph_status sph__step_begin(sph_world* w, sph_real dt, sph_solver solver) 
     w->priv.solver = (int)solver;
     if (settle) { /* fluid placed compressed moved apart before time starts (sph__settle_placed) */
         /* a start it refuses is put back as it was: sph_advance restores its own copy, a bare
-           sph_step this one (the settling sorts and moves the particles) */
+           sph_step this one (the settling sorts and moves the particles), freed after use */
         const int keep = settle == 1 && w->priv.settle_snap == 0;
         if (keep && (s = sph__snapshot_take(w, 0)) != SPH_OK) {
             w->priv.placed = 1;
             return s;
         }
         s = sph__settle_placed(w, settle == 2);
-        if (s == SPH_ERR_ARG && keep) sph__restore_named(w, 0);
+        if (keep) {
+            if (s == SPH_ERR_ARG) sph__restore_named(w, 0);
+            SPH_FREE(w->priv.snap[0]);
+            w->priv.snap[0] = NULL;
+            w->priv.snap_cap[0] = 0;
+        }
         if (s != SPH_OK) w->priv.placed = 1; /* checked and settled again by the next attempt */
         /* sph_advance retries a failed first sub-step from here, not from before the settling
            (the same positions again, 500 projections each): a call whose 13 attempts failed took
@@ -11517,7 +11524,7 @@ SPHDEF sph_status sph_advance(sph_world* w, sph_real duration) {
         if (w->priv.dt_unpressed > 4 * dt_stable)
             w->priv.correct_fraction *= 4 * dt_stable / w->priv.dt_unpressed;
         w->priv.cold_start = in_row > (w->def.boundary_pressure == SPH_BP_EXTRAPOLATE ? 0 : 1);
-        w->priv.settle_snap = first;
+        w->priv.settle_snap = first ? 1 : 3; /* 0 is a bare sph_step's */
         s = sph_step(w, (sph_real)dt);
         if (w->priv.settle_snap == 2) first_slot = 1;
         w->priv.settle_snap = 0;

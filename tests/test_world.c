@@ -815,11 +815,48 @@ static void test_auto_kernel(void) {
     }
 }
 
+/* sph_world_memory counts sph_advance's copies of the state to roll back to: two copies of at
+   least x, v, rho and p of every fluid particle (the call's start and the sub-step's start) that a
+   world stepped only by sph_step does not hold. The same 2D dam break (IISPH, dx 0.02) once
+   through sph_step and once through sph_advance over several sub-steps. */
+static void test_memory_counts_rollback(void) {
+    size_t mem[2], n = 0;
+    int way;
+    for (way = 0; way < 2; ++way) {
+        sph_world_def def = sph_world_def_default(2);
+        sph_world w;
+        sph_phase water;
+        const sph_real lo[2] = {0, 0}, col[2] = {0.4f, 0.6f}, tank[2] = {1, 1};
+        memset(&water, 0, sizeof water);
+        water.rest_density = 1000;
+        def.spacing = (sph_real)0.02;
+        def.solver = SPH_SOLVER_IISPH;
+        CHECK_EQ_INT(sph_world_init(&w, &def), SPH_OK);
+        CHECK(sph_world_add_phase(&w, &water) == 0);
+        CHECK_EQ_INT(sph_fill_box(&w, 0, lo, col), SPH_OK);
+        CHECK_EQ_INT(sph_add_wall_box(&w, lo, tank, 0, 0), SPH_OK);
+        if (way == 0) {
+            int k;
+            for (k = 0; k < 5; ++k) CHECK_EQ_INT(sph_step(&w, sph_stable_dt(&w, def.solver)), SPH_OK);
+        } else {
+            CHECK_EQ_INT(sph_advance(&w, (sph_real)0.02), SPH_OK);
+            CHECK(w.stats.substeps >= 2);
+        }
+        mem[way] = sph_world_memory(&w);
+        n = w.n;
+        sph_world_free(&w);
+    }
+    TH_NOTE("%zu fluid particles: %zu bytes after sph_step, %zu after sph_advance", n, mem[0],
+            mem[1]);
+    CHECK(mem[1] >= mem[0] + 2 * n * 6 * sizeof(sph_real));
+}
+
 const th_test tests_world[] = {
     {"world/def_fields_rejected_by_name", test_def_fields},
     {"world/phase_fields_rejected_by_name", test_phase_fields},
     {"world/fill_box_counts_ids_masses", test_fill_and_masses},
     {"world/fill_box_fits_the_box", test_fill_box_fits},
+    {"world/memory_counts_rollback", test_memory_counts_rollback},
     {"world/wall_box_count_and_volume", test_wall_box},
     {"world/hydrostatic_init", test_hydrostatic_init},
     {"world/bad_step_input_leaves_world_unchanged", test_bad_step_input},
