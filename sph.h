@@ -4393,8 +4393,9 @@ static sph_status sph__check_coincident(sph_world* w, const char* fn, size_t m, 
     }
     SPH_FREE(head);
     if (!found) return SPH_OK;
-    if (found_b < n)
-        return sph__fail(w, SPH_ERR_ARG, (long)found_a,
+    if (found_b < n) /* the error names the caller's particle, or (sph_fill_box, whose points
+                        are its own) the world's (found by tests/fuzz_api.c) */
+        return sph__fail(w, SPH_ERR_ARG, (long)(given == SPH__POINTS_DISTINCT ? found_b : found_a),
                          "%s: particle %zu lies within %g spacings of fluid particle %zu (id %u) "
                          "already in the world (the same fluid added twice?): coincident "
                          "particles never separate; nothing added",

@@ -8,6 +8,7 @@
 #include "../sph.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
@@ -917,9 +918,10 @@ static void test_tank_check(void) {
 
 /* Fluid added where fluid already is: the same box filled twice, or an array holding a particle
    twice (or within 1e-3 spacings of one), is refused with SPH_ERR_ARG and a message naming both
-   particles, nothing added (coincident particles have a zero kernel gradient between them and
-   never separate: WCSPH ran a box filled twice at twice its weight without a sign, IISPH and
-   DFSPH threw its particles at 60 m/s). Close but not coincident is accepted: 0.3 spacings off,
+   particles (w.error_index the caller's, or for sph_fill_box the world's), nothing added
+   (coincident particles have a zero kernel gradient between them and never separate: WCSPH ran
+   a box filled twice at twice its weight without a sign, IISPH and DFSPH threw its particles at
+   60 m/s). Close but not coincident is accepted: 0.3 spacings off,
    or particles of a new box that only touch the old one. 2D and 3D. */
 static void test_coincident_refused(void) {
     int dim;
@@ -930,6 +932,8 @@ static void test_coincident_refused(void) {
         const sph_real lo[3] = {0, 0, 0}, hi[3] = {(sph_real)0.2, (sph_real)0.2, (sph_real)0.2};
         const sph_real lo2[3] = {(sph_real)0.2, 0, 0},
                        hi2[3] = {(sph_real)0.3, (sph_real)0.2, (sph_real)0.2};
+        const sph_real lo3[3] = {0, (sph_real)0.1, 0},
+                       hi3[3] = {(sph_real)0.2, (sph_real)0.3, (sph_real)0.2};
         sph_real x[6];
         size_t n0;
         int k;
@@ -942,6 +946,15 @@ static void test_coincident_refused(void) {
         CHECK_EQ_INT(sph_fill_box(&w, 0, lo, hi), SPH_ERR_ARG); /* the same box again */
         CHECK_MSG(strstr(w.error, "sph_fill_box") && strstr(w.error, "never separate"), "%s",
                   w.error);
+        /* half of it again: w.error_index names the world's particle (the box's points are not
+           the caller's; it named the box's own first point, found by tests/fuzz_api.c) */
+        CHECK_EQ_INT(sph_fill_box(&w, 0, lo3, hi3), SPH_ERR_ARG);
+        {
+            char named[64];
+            snprintf(named, sizeof named, "fluid particle %ld ", w.error_index);
+            CHECK(w.error_index >= 0 && (size_t)w.error_index < n0);
+            CHECK_MSG(strstr(w.error, named) != NULL, "%s: %s", named, w.error);
+        }
         CHECK_EQ_INT(w.n, n0);
         /* one particle 1e-4 spacings from particle 5, one 0.3 spacings from particle 9 */
         for (k = 0; k < dim; ++k) {
@@ -951,6 +964,7 @@ static void test_coincident_refused(void) {
         CHECK_EQ_INT(sph_add_fluid(&w, 0, 2, x, NULL), SPH_ERR_ARG);
         CHECK_MSG(strstr(w.error, "particle 0 lies within") && strstr(w.error, "(id 5)"), "%s",
                   w.error);
+        CHECK(w.error_index == 0); /* the caller's particle */
         CHECK_EQ_INT(w.n, n0);
         CHECK_EQ_INT(sph_add_fluid(&w, 0, 1, x + dim, NULL), SPH_OK); /* 0.3 dx off: accepted */
         CHECK_EQ_INT(w.n, n0 + 1);

@@ -837,7 +837,8 @@ static void test_memory_counts_rollback(void) {
         CHECK_EQ_INT(sph_add_wall_box(&w, lo, tank, 0, 0), SPH_OK);
         if (way == 0) {
             int k;
-            for (k = 0; k < 5; ++k) CHECK_EQ_INT(sph_step(&w, sph_stable_dt(&w, def.solver)), SPH_OK);
+            for (k = 0; k < 5; ++k)
+                CHECK_EQ_INT(sph_step(&w, sph_stable_dt(&w, def.solver)), SPH_OK);
         } else {
             CHECK_EQ_INT(sph_advance(&w, (sph_real)0.02), SPH_OK);
             CHECK(w.stats.substeps >= 2);
