@@ -171,8 +171,9 @@ static void test_slosh_confined(void) {
    sound speed, which assumes |v| < sqrt(2 g H)). It used to record failures: WCSPH let 8 of 768
    particles through the extrapolated walls, enhanced PCISPH blew up at t = 1.29 s (reported).
    Measured now (double): every solver holds the tank through t = 3.05 s with no failure, 0 of
-   768 particles outside; largest speeds 5.20 m/s (WCSPH, 16914 steps), 5.01 (enhanced PCISPH,
-   3175 steps), 5.93 (IISPH, 1924 steps). Asserted: status OK and no particle outside. */
+   768 particles outside; largest speeds 6.46 m/s (WCSPH, 31860 steps: its automatic sound
+   speed follows the flow, see sph__sound_speed_follows_flow), 5.36 (enhanced PCISPH, 3169
+   steps), 4.56 (IISPH, 1854 steps). Asserted: status OK and no particle outside. */
 static void test_slosh_violent(void) {
     slosh(solver_def(0), SPH_BP_EXTRAPOLATE, 0.5, 0.0125, 3.0, 1);
     slosh(solver_def(1), SPH_BP_EXTRAPOLATE, 0.5, 0.0125, 3.0, 1);
