@@ -11489,6 +11489,8 @@ static void sph__snapshot_restore(sph_world* w, int slot) {
           moving too far) or SPH_ERR_NOT_CONVERGED is undone bit for bit and retried with half
           the step (dt_factor halves), at most SPH__RETRIES times in a row;
      after each successful sub-step dt_factor grows by 1.1 back towards 1;
+     before each WCSPH sub-step of a scene with a force callback or moving walls, a derived
+          sound speed follows the flow (sph__sound_speed_follows_flow);
      a sub-step that still fails (not the call's first) is taken as a sign that an accepted
           sub-step left a state no step can continue from: the call starts again from its
           beginning at a quarter of the step it began with, at most twice.
