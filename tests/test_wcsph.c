@@ -1008,10 +1008,11 @@ static void test_sound_speed_follows_flow(void) {
         for (i = 0; i < w.n; ++i) {
             const double x = (double)w.x[2 * i], y = (double)w.x[2 * i + 1];
             const double v = hypot((double)w.v[2 * i], (double)w.v[2 * i + 1]);
+            const double m = v / (double)w.phases[0].sound_speed;
             out += x < 0 || x > W || y < 0 || y > Ht;
             if ((double)w.rho[i] / 1000 - 1 > comp) comp = (double)w.rho[i] / 1000 - 1;
             if (v > vmax) vmax = v;
-            if (v / (double)w.phases[0].sound_speed > mach) mach = v / (double)w.phases[0].sound_speed;
+            if (m > mach) mach = m;
         }
     }
     TH_NOTE("c0 %.1f -> %.1f m/s, largest speed %.2f m/s (%.2f sqrt(2 g H)), Mach <= %.3f, "
