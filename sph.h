@@ -252,6 +252,9 @@ int main(void) {
    against 19); at the default 1e-3 both are alike (2.9 and 3.8 a step), and so is a small 3D dam
    break at either tolerance. Use it with a tighter tolerance (1e-4) where a tank must come to
    rest: a 2D tank's late speed 0.014-0.032 sqrt(g H) against 0.029-0.049 (README).
+   def.shifting (particle shifting, see sph__stage_shift) applies to IISPH and DFSPH as to WCSPH,
+   for flows that fill their walls: a vortex in a closed 2D box then decays 1.7 times its exact
+   rate instead of 3.3 (IISPH) and 3.2 (DFSPH), the disordered lattice's excess.
 
    SOLVER: DFSPH (sph_step_dfsph, or def.solver = SPH_SOLVER_DFSPH)
    Divergence-free SPH (Bender & Koschier 2015, 2017): per step a divergence-free solve on the
@@ -1084,11 +1087,14 @@ typedef struct sph_world_def {
     sph_real alpha;            /* Monaghan artificial viscosity alpha [-]; default 0.02; [0, 10]  */
     sph_real beta;             /* Monaghan artificial viscosity beta [-]; default 0; [0, 10]      */
     sph_real shifting;         /* particle shifting coefficient A [-] (see >>wcsph,
-                                  sph__stage_shift): each WCSPH step moves fluid particle i by
-                                  -A h U dt sum_j V_j (1 + 0.2 (W_ij/W(dx))^4) grad W_ij, U the
-                                  last step's largest speed; 4 is Sun et al. 2017's delta+-SPH.
-                                  Default 0 (off); [0, 10]; WCSPH, standard scheme. No free-
-                                  surface treatment: for flows that fill their walls          */
+                                  sph__stage_shift): each step moves fluid particle i by
+                                  -D sum_j V_j (1 + 0.2 (W_ij/W(dx))^4) grad W_ij, D = A h U dt
+                                  but at most 0.2 h^2 / dim, U the last step's largest speed;
+                                  4 is Sun et al. 2017's delta+-SPH. Default 0 (off); [0, 10];
+                                  WCSPH (standard scheme), IISPH and DFSPH. No free-surface
+                                  treatment: for flows that fill their walls (a vortex in a
+                                  closed 2D box decays 1.1-1.7 times its exact rate with A = 4,
+                                  3.2-4.2 times without: README, Validation)                   */
     sph_viscosity_form viscosity_form; /* laminar viscosity operator; default SPH_VISC_MORRIS    */
     sph_wall wall;             /* default SPH_WALL_FREE_SLIP                                      */
     sph_boundary_pressure boundary_pressure; /* default SPH_BP_AUTO (see there)                   */
@@ -3602,9 +3608,10 @@ static sph_status sph__validate_def(sph_world* w, const sph_world_def* d) {
     SPH__CHECK(sph__finite((double)d->shifting) && d->shifting >= 0 && d->shifting <= 10,
                "sph_world_def.shifting = %g: must be in [0, 10]", (double)d->shifting);
     SPH__CHECK(d->shifting == 0 || (d->solver == SPH_SOLVER_WCSPH &&
-                                    d->scheme == SPH_SCHEME_STANDARD),
-               "sph_world_def.shifting = %g: WCSPH with SPH_SCHEME_STANDARD only (the second-order "
-               "scheme shifts by def.shift_every)", (double)d->shifting);
+                                    d->scheme == SPH_SCHEME_STANDARD) ||
+                   d->solver == SPH_SOLVER_IISPH || d->solver == SPH_SOLVER_DFSPH,
+               "sph_world_def.shifting = %g: WCSPH with SPH_SCHEME_STANDARD, IISPH or DFSPH only "
+               "(the second-order scheme shifts by def.shift_every)", (double)d->shifting);
     SPH__CHECK((int)d->clamp >= 0 && d->clamp <= SPH_CLAMP_OFF,
                "sph_world_def.clamp = %d: not a sph_pressure_clamp", (int)d->clamp);
     SPH__CHECK((int)d->viscosity_form >= 0 && d->viscosity_form <= SPH_VISC_MONAGHAN,
@@ -8634,7 +8641,22 @@ static sph_status sph__rate_cache(sph_world* w, sph__ctx* c) {
    first order in h U dt per step and moves no particle of a fluid at rest (U = 0). Density and
    velocity are not corrected for the shift (an error of the shift's order). A free surface would
    pull its particles outwards (no surface detection here): for flows that fill their walls. Gather
-   only: each particle writes its own shift, then all move. */
+   only: each particle writes its own shift, then all move.
+   IISPH and DFSPH (after the pressure solve, before the drift; their density is summed again at
+   the next step, so the shift needs no density correction) take 5-10 times WCSPH's step, and
+   D = A h U dt grows with it: the shift is an explicit diffusion step of the particle
+   concentration, stable only below a D that falls like 1/dim (the Laplacian's largest eigenvalue
+   sums over the directions). In a 2D vortex box of 25 x 25 particles (U = 1 m/s) A = 4 at
+   IISPH's step gave D = 0.6 h^2: it overshot, a particle at a wall reached 15 m/s and the step
+   failed (reported); 0.25 h^2 held with retries. In the 3D box (20 x 20 x 6) 0.1 h^2 raised the
+   kinetic energy from one 0.05 s frame to the next by 1.0 % (IISPH) and 2.4 % (DFSPH) of its
+   start; 0.067 h^2 and 0.05 h^2 did not. So D <= 0.2 h^2 / dim (SPH__SHIFT_DMAX): 0.1 h^2 in
+   2D, about WCSPH's own D at its acoustic step (A CFL Ma h^2 = 4 x 0.25 x 0.1 h^2), so WCSPH's
+   2D shifts are unchanged. Measured in the vortex boxes, the kinetic energy's decay over its
+   exact rate in 2D (tests/test_viscous.c): IISPH 3.3 -> 1.7, DFSPH 3.2 -> 1.7, WCSPH 4.2 ->
+   1.13; the 3D box's kinetic energy after 0.5 s (exact 0.82 of its start): IISPH 0.48 -> 0.59,
+   DFSPH 0.48 -> 0.60, WCSPH 0.53 -> 0.80. */
+#define SPH__SHIFT_DMAX SPH__R(0.2) /* dim times the bound on A h U dt [h^2]: sph__stage_shift */
 static sph_status sph__shift_reserve(sph_world* w) {
     if (!(w->def.shifting > 0)) return SPH_OK;
     return sph__scratch(w, &w->priv.shift, w->capacity * (size_t)w->dim);
@@ -8659,7 +8681,9 @@ SPH__INLINE void sph__shift_pair(const sph__ctx* c, sph_real inv_wdx, const sph_
 static void sph__stage_shift(sph_world* w, const sph__ctx* c, sph_real dt) {
     const int D = c->dim, form = c->k.form;
     const sph_real inv_wdx = 1 / sph__kw(form, w->dx * c->k.inv_h);
-    const sph_real coef = -w->def.shifting * c->h * (sph_real)w->stats.v_max * dt;
+    const sph_real dmax = SPH__SHIFT_DMAX * c->h * c->h / (sph_real)D;
+    const sph_real coef0 = w->def.shifting * c->h * (sph_real)w->stats.v_max * dt;
+    const sph_real coef = -(coef0 < dmax ? coef0 : dmax);
     sph_real* sh = w->priv.shift;
     sph__idx i;
     if (!(w->def.shifting > 0) || !(coef < 0)) return;
@@ -10023,7 +10047,8 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
     sph_status s;
     sph__idx i;
     int it = 0;
-    if ((s = sph__scratch(w, &w->priv.aii, w->capacity)) != SPH_OK ||
+    if ((s = sph__shift_reserve(w)) != SPH_OK ||
+        (s = sph__scratch(w, &w->priv.aii, w->capacity)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.src, w->capacity)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.ap, w->capacity * (size_t)w->dim)) != SPH_OK ||
         (w->nb > 0 &&
@@ -10116,6 +10141,7 @@ static sph_status sph__step_iisph(sph_world* w, sph_real dt) {
     }
     w->stats.iterations = it;
     w->stats.solver_error = err;
+    sph__stage_shift(w, &c, dt);
     ++w->steps;
     w->time += (double)dt;
     s = sph__integrate(w, &c, 0, 0, dt, 1);
@@ -10361,7 +10387,8 @@ static sph_status sph__step_dfsph(sph_world* w, sph_real dt) {
     sph_status s;
     sph__idx i;
     int it, itv;
-    if ((s = sph__scratch(w, &w->priv.ap, w->capacity * (size_t)w->dim)) != SPH_OK ||
+    if ((s = sph__shift_reserve(w)) != SPH_OK ||
+        (s = sph__scratch(w, &w->priv.ap, w->capacity * (size_t)w->dim)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.df_vs, w->capacity * (size_t)w->dim)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.df_alpha, w->capacity)) != SPH_OK ||
         (s = sph__scratch(w, &w->priv.df_alpha_v, w->capacity)) != SPH_OK ||
@@ -10452,6 +10479,7 @@ static sph_status sph__step_dfsph(sph_world* w, sph_real dt) {
     w->stats.iterations_divergence = itv;
     w->stats.solver_error = err;
     w->stats.divergence_error = errv;
+    sph__stage_shift(w, &c, dt);
     ++w->steps;
     w->time += (double)dt;
     s = sph__integrate(w, &c, 0, 0, dt, 1);

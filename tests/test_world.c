@@ -95,7 +95,8 @@ static void test_def_fields(void) {
         {"boundary_pressure", 21, SPH_SOLVER_COMPRESSIBLE},
         {"boundary_pressure", 21, SPH_SOLVER_PBF},
         {"shifting", 22, -1},   {"shifting", 22, 11},    {"shifting", 22, NAN},
-        {"shifting", 23, SPH_SOLVER_IISPH},              {"shifting", 23, SPH_SOLVER_PCISPH},
+        {"shifting", 23, SPH_SOLVER_PBF},                {"shifting", 23, SPH_SOLVER_PCISPH},
+        {"shifting", 23, SPH_SOLVER_COMPRESSIBLE},
         {"shifting", 24, 0},
     };
     size_t c;
@@ -131,7 +132,7 @@ static void test_def_fields(void) {
             d.periodic[0] = 1; d.domain_lo[0] = 0; d.domain_hi[0] = d.spacing * 3; break;
         case 21: d.solver = (sph_solver)(int)v; d.boundary_pressure = SPH_BP_MIRROR; break;
         case 22: d.shifting = (sph_real)v; break;
-        case 23: d.solver = (sph_solver)(int)v; d.shifting = 4; break; /* WCSPH only */
+        case 23: d.solver = (sph_solver)(int)v; d.shifting = 4; break; /* WCSPH, IISPH, DFSPH */
         case 24: d.scheme = SPH_SCHEME_SECOND_ORDER; d.shifting = 4; break; /* it shifts itself */
         }
         s = sph_world_init(&w, &d);
