@@ -8651,10 +8651,10 @@ static sph_status sph__rate_cache(sph_world* w, sph__ctx* c) {
    failed (reported); 0.25 h^2 held with retries. In the 3D box (20 x 20 x 6) 0.1 h^2 raised the
    kinetic energy from one 0.05 s frame to the next by 1.0 % (IISPH) and 2.4 % (DFSPH) of its
    start; 0.067 h^2 and 0.05 h^2 did not. So D <= 0.2 h^2 / dim (SPH__SHIFT_DMAX): 0.1 h^2 in
-   2D, about WCSPH's own D at its acoustic step (A CFL Ma h^2 = 4 x 0.25 x 0.1 h^2), so WCSPH's
-   2D shifts are unchanged. Measured in the vortex boxes, the kinetic energy's decay over its
-   exact rate in 2D (tests/test_viscous.c): IISPH 3.3 -> 1.7, DFSPH 3.2 -> 1.7, WCSPH 4.2 ->
-   1.13; the 3D box's kinetic energy after 0.5 s (exact 0.82 of its start): IISPH 0.48 -> 0.59,
+   2D, WCSPH's own D at its acoustic step at Mach 0.1 (A CFL Ma h^2 = 4 x 0.25 x 0.1 h^2), so
+   WCSPH's 2D shifts are unchanged below that Mach number. Measured in the vortex boxes, the
+   kinetic energy's decay over its exact rate in 2D (tests/test_viscous.c): IISPH 3.3 -> 1.7,
+   DFSPH 3.2 -> 1.7, WCSPH 4.2 -> 1.13; the 3D box's kinetic energy after 0.5 s (exact 0.82 of its start): IISPH 0.48 -> 0.59,
    DFSPH 0.48 -> 0.60, WCSPH 0.53 -> 0.80. The shift moves mass without work: in the same 3D box
    under gravity (A = 4, at the bound) the mechanical energy rose from one 0.05 s frame to the
    next by up to 0.07 % (IISPH) and 0.8 % (DFSPH) of the start's kinetic energy, and A = 1 by
