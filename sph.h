@@ -8643,18 +8643,18 @@ static sph_status sph__rate_cache(sph_world* w, sph__ctx* c) {
    pull its particles outwards (no surface detection here): for flows that fill their walls. Gather
    only: each particle writes its own shift, then all move.
    IISPH and DFSPH (after the pressure solve, before the drift; their density is summed again at
-   the next step, so the shift needs no density correction) take 5-10 times WCSPH's step, and
-   D = A h U dt grows with it: the shift is an explicit diffusion step of the particle
-   concentration, stable only below a D that falls like 1/dim (the Laplacian's largest eigenvalue
-   sums over the directions). In a 2D vortex box of 25 x 25 particles (U = 1 m/s) A = 4 at
-   IISPH's step gave D = 0.6 h^2: it overshot, a particle at a wall reached 15 m/s and the step
-   failed (reported); 0.25 h^2 held with retries. In the 3D box (20 x 20 x 6) 0.1 h^2 raised the
-   kinetic energy from one 0.05 s frame to the next by 1.0 % (IISPH) and 2.4 % (DFSPH) of its
-   start; 0.067 h^2 and 0.05 h^2 did not. So D <= 0.2 h^2 / dim (SPH__SHIFT_DMAX): 0.1 h^2 in
-   2D, WCSPH's own D at its acoustic step at Mach 0.1 (A CFL Ma h^2 = 4 x 0.25 x 0.1 h^2), so
-   WCSPH's 2D shifts are unchanged below that Mach number. Measured in the vortex boxes, the
-   kinetic energy's decay over its exact rate in 2D (tests/test_viscous.c): IISPH 3.3 -> 1.7,
-   DFSPH 3.2 -> 1.7, WCSPH 4.2 -> 1.13; the 3D box's kinetic energy after 0.5 s (exact 0.82 of its start): IISPH 0.48 -> 0.59,
+   the next step, so the shift needs no density correction) take 5-10 times WCSPH's step, and D =
+   A h U dt grows with it: the shift is an explicit diffusion step of the particle concentration,
+   stable only below a D that falls like 1/dim (the Laplacian's largest eigenvalue sums over the
+   directions). In a 2D vortex box of 25 x 25 particles (U = 1 m/s) A = 4 at IISPH's step gave D =
+   0.6 h^2: it overshot, a particle at a wall reached 15 m/s and the step failed (reported); 0.25
+   h^2 held with retries. In the 3D box (20 x 20 x 6) 0.1 h^2 raised the kinetic energy from one
+   0.05 s frame to the next by 1.0 % (IISPH) and 2.4 % (DFSPH) of its start; 0.067 h^2 and 0.05
+   h^2 did not. So D <= 0.2 h^2 / dim (SPH__SHIFT_DMAX): 0.1 h^2 in 2D, WCSPH's own D at its
+   acoustic step at Mach 0.1 (A CFL Ma h^2 = 4 x 0.25 x 0.1 h^2), so WCSPH's 2D shifts are
+   unchanged below that Mach number. Measured in the vortex boxes, the kinetic energy's decay over
+   its exact rate in 2D (tests/test_viscous.c): IISPH 3.3 -> 1.7, DFSPH 3.2 -> 1.7, WCSPH 4.2 ->
+   1.13; the 3D box's kinetic energy after 0.5 s (exact 0.82 of its start): IISPH 0.48 -> 0.59,
    DFSPH 0.48 -> 0.60, WCSPH 0.53 -> 0.80. The shift moves mass without work: in the same 3D box
    under gravity (A = 4, at the bound) the mechanical energy rose from one 0.05 s frame to the
    next by up to 0.07 % (IISPH) and 0.8 % (DFSPH) of the start's kinetic energy, and A = 1 by
