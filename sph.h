@@ -253,8 +253,10 @@ int main(void) {
    break at either tolerance. Use it with a tighter tolerance (1e-4) where a tank must come to
    rest: a 2D tank's late speed 0.014-0.032 sqrt(g H) against 0.029-0.049 (README).
    def.shifting (particle shifting, see sph__stage_shift) applies to IISPH and DFSPH as to WCSPH,
-   for flows that fill their walls: a vortex in a closed 2D box then decays 1.7 times its exact
-   rate instead of 3.3 (IISPH) and 3.2 (DFSPH), the disordered lattice's excess.
+   for flows that fill their walls, with half WCSPH's bound on the shift per step (their density
+   is summed again, so what a shift compresses the next solve pushes apart, against gravity with
+   work the shift never paid): a vortex in a closed 2D box then decays 2.0 (IISPH) and 2.1
+   (DFSPH) times its exact rate instead of 3.3 and 3.2, the disordered lattice's excess.
 
    SOLVER: DFSPH (sph_step_dfsph, or def.solver = SPH_SOLVER_DFSPH)
    Divergence-free SPH (Bender & Koschier 2015, 2017): per step a divergence-free solve on the
@@ -1089,11 +1091,12 @@ typedef struct sph_world_def {
     sph_real shifting;         /* particle shifting coefficient A [-] (see >>wcsph,
                                   sph__stage_shift): each step moves fluid particle i by
                                   -D sum_j V_j (1 + 0.2 (W_ij/W(dx))^4) grad W_ij, D = A h U dt
-                                  but at most 0.2 h^2 / dim, U the last step's largest speed;
+                                  but at most 0.2 h^2 / dim (IISPH, DFSPH: 0.1 h^2 / dim), U
+                                  the last step's largest speed;
                                   4 is Sun et al. 2017's delta+-SPH. Default 0 (off); [0, 10];
                                   WCSPH (standard scheme), IISPH and DFSPH. No free-surface
                                   treatment: for flows that fill their walls (a vortex in a
-                                  closed 2D box decays 1.1-1.7 times its exact rate with A = 4,
+                                  closed 2D box decays 1.1-2.1 times its exact rate with A = 4,
                                   3.2-4.2 times without: README, Validation)                   */
     sph_viscosity_form viscosity_form; /* laminar viscosity operator; default SPH_VISC_MORRIS    */
     sph_wall wall;             /* default SPH_WALL_FREE_SLIP                                      */
@@ -8652,15 +8655,24 @@ static sph_status sph__rate_cache(sph_world* w, sph__ctx* c) {
    0.05 s frame to the next by 1.0 % (IISPH) and 2.4 % (DFSPH) of its start; 0.067 h^2 and 0.05
    h^2 did not. So D <= 0.2 h^2 / dim (SPH__SHIFT_DMAX): 0.1 h^2 in 2D, WCSPH's own D at its
    acoustic step at Mach 0.1 (A CFL Ma h^2 = 4 x 0.25 x 0.1 h^2), so WCSPH's 2D shifts are
-   unchanged below that Mach number. Measured in the vortex boxes, the kinetic energy's decay over
-   its exact rate in 2D (tests/test_viscous.c): IISPH 3.3 -> 1.7, DFSPH 3.2 -> 1.7, WCSPH 4.2 ->
-   1.13; the 3D box's kinetic energy after 0.5 s (exact 0.82 of its start): IISPH 0.48 -> 0.59,
-   DFSPH 0.48 -> 0.60, WCSPH 0.53 -> 0.80. The shift moves mass without work: in the same 3D box
-   under gravity (A = 4, at the bound) the mechanical energy rose from one 0.05 s frame to the
-   next by up to 0.07 % (IISPH) and 0.8 % (DFSPH) of the start's kinetic energy, and A = 1 by
-   1.3 % (IISPH); A = 0.5 and 0.25 and WCSPH with A = 4 by none; the frame-end mean density error
-   1.2-1.9 % against 0.15-0.24 % unshifted (the next solve removes what the shift compressed). */
+   unchanged below that Mach number. IISPH and DFSPH take half that (SPH__SHIFT_DMAX_SUMMED): the
+   shift moves mass without work, and their summed density turns what it compresses into pressure
+   that the next solve spends pushing the particles apart; against gravity's hydrostatic pressure
+   that push puts energy in. In the vortex box under gravity (2D 25 x 25 and 3D 20 x 20 x 6,
+   A = 4, frames of 0.04-0.125 s, tests/test_viscous.c box_gravity_shifting) the mechanical
+   energy rose from one frame to the next in 8 of 16 runs at 0.2 h^2 / dim, by up to 8.6 % (2D)
+   and 20 % (3D) of the start's kinetic energy, and in none at 0.1 h^2 / dim. WCSPH carries its
+   density: its particles move with their density and pressure, and it rose in none of 6 such
+   runs. Shifting before the density summation instead (so that the same step's solve removes
+   the compression) was worse: the 3D box under gravity gained 34 % in a frame. Measured in the
+   vortex boxes without gravity, the kinetic energy's decay over its exact rate in 2D
+   (tests/test_viscous.c): IISPH 3.3 -> 2.0, DFSPH 3.2 -> 2.1, WCSPH 4.2 -> 1.13 (IISPH and DFSPH
+   1.7 at 0.2 h^2 / dim); the 3D box's kinetic energy after 0.5 s (exact 0.82 of its start):
+   IISPH 0.48 -> 0.54, DFSPH 0.48 -> 0.54, WCSPH 0.53 -> 0.80. The frame-end mean density error
+   (summed afresh) of IISPH and DFSPH is 0.3-0.4 % (2D) and 0.7-1.1 % (3D) against 0.2-0.37 %
+   unshifted (the next solve removes what the shift compressed). */
 #define SPH__SHIFT_DMAX SPH__R(0.2) /* dim times the bound on A h U dt [h^2]: sph__stage_shift */
+#define SPH__SHIFT_DMAX_SUMMED SPH__R(0.1) /* the same for IISPH and DFSPH (summation density) */
 static sph_status sph__shift_reserve(sph_world* w) {
     if (!(w->def.shifting > 0)) return SPH_OK;
     return sph__scratch(w, &w->priv.shift, w->capacity * (size_t)w->dim);
@@ -8685,7 +8697,9 @@ SPH__INLINE void sph__shift_pair(const sph__ctx* c, sph_real inv_wdx, const sph_
 static void sph__stage_shift(sph_world* w, const sph__ctx* c, sph_real dt) {
     const int D = c->dim, form = c->k.form;
     const sph_real inv_wdx = 1 / sph__kw(form, w->dx * c->k.inv_h);
-    const sph_real dmax = SPH__SHIFT_DMAX * c->h * c->h / (sph_real)D;
+    const int summed = w->priv.solver == SPH_SOLVER_IISPH || w->priv.solver == SPH_SOLVER_DFSPH;
+    const sph_real dmax =
+        (summed ? SPH__SHIFT_DMAX_SUMMED : SPH__SHIFT_DMAX) * c->h * c->h / (sph_real)D;
     const sph_real coef0 = w->def.shifting * c->h * (sph_real)w->stats.v_max * dt;
     const sph_real coef = -(coef0 < dmax ? coef0 : dmax);
     sph_real* sh = w->priv.shift;
