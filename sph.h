@@ -8655,10 +8655,10 @@ static sph_status sph__rate_cache(sph_world* w, sph__ctx* c) {
    0.05 s frame to the next by 1.0 % (IISPH) and 2.4 % (DFSPH) of its start; 0.067 h^2 and 0.05
    h^2 did not. So D <= 0.2 h^2 / dim (SPH__SHIFT_DMAX): 0.1 h^2 in 2D, WCSPH's own D at its
    acoustic step at Mach 0.1 (A CFL Ma h^2 = 4 x 0.25 x 0.1 h^2), so WCSPH's 2D shifts are
-   unchanged below that Mach number. IISPH and DFSPH take half that (SPH__SHIFT_DMAX_SUMMED): the
-   shift moves mass without work, and their summed density turns what it compresses into pressure
-   that the next solve spends pushing the particles apart; against gravity's hydrostatic pressure
-   that push puts energy in. In the vortex box under gravity (2D 25 x 25 and 3D 20 x 20 x 6,
+   unchanged below that Mach number. IISPH and DFSPH (every summation density) take half that
+   (SPH__SHIFT_DMAX_SUMMED): the shift moves mass without work, and a summed density turns what it
+   compresses into pressure that the next solve spends pushing the particles apart; against
+   gravity's hydrostatic pressure that push puts energy in. In the vortex box under gravity (2D 25 x 25 and 3D 20 x 20 x 6,
    A = 4, frames of 0.04-0.125 s, tests/test_viscous.c box_gravity_shifting) the mechanical
    energy rose from one frame to the next in 8 of 16 runs at 0.2 h^2 / dim, by up to 8.6 % (2D)
    and 20 % (3D) of the start's kinetic energy, and in none at 0.1 h^2 / dim. WCSPH carries its
@@ -8673,7 +8673,7 @@ static sph_status sph__rate_cache(sph_world* w, sph__ctx* c) {
    density error (summed afresh) of IISPH and DFSPH is 0.3-0.4 % (2D) and 0.7-1.1 % (3D) against
    0.2-0.37 % unshifted (the next solve removes what the shift compressed). */
 #define SPH__SHIFT_DMAX SPH__R(0.2) /* dim times the bound on A h U dt [h^2]: sph__stage_shift */
-#define SPH__SHIFT_DMAX_SUMMED SPH__R(0.1) /* the same for IISPH and DFSPH (summation density) */
+#define SPH__SHIFT_DMAX_SUMMED SPH__R(0.1) /* the same for a summation density (IISPH, DFSPH) */
 static sph_status sph__shift_reserve(sph_world* w) {
     if (!(w->def.shifting > 0)) return SPH_OK;
     return sph__scratch(w, &w->priv.shift, w->capacity * (size_t)w->dim);
@@ -8698,7 +8698,7 @@ SPH__INLINE void sph__shift_pair(const sph__ctx* c, sph_real inv_wdx, const sph_
 static void sph__stage_shift(sph_world* w, const sph__ctx* c, sph_real dt) {
     const int D = c->dim, form = c->k.form;
     const sph_real inv_wdx = 1 / sph__kw(form, w->dx * c->k.inv_h);
-    const int summed = w->priv.solver == SPH_SOLVER_IISPH || w->priv.solver == SPH_SOLVER_DFSPH;
+    const int summed = !sph__carries_density_for(w, w->priv.solver);
     const sph_real dmax =
         (summed ? SPH__SHIFT_DMAX_SUMMED : SPH__SHIFT_DMAX) * c->h * c->h / (sph_real)D;
     const sph_real coef0 = w->def.shifting * c->h * (sph_real)w->stats.v_max * dt;
