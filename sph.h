@@ -8658,9 +8658,9 @@ static sph_status sph__rate_cache(sph_world* w, sph__ctx* c) {
    unchanged below that Mach number. IISPH and DFSPH (every summation density) take half that
    (SPH__SHIFT_DMAX_SUMMED): the shift moves mass without work, and a summed density turns what it
    compresses into pressure that the next solve spends pushing the particles apart; against
-   gravity's hydrostatic pressure that push puts energy in. In the vortex box under gravity (2D 25 x 25 and 3D 20 x 20 x 6,
-   A = 4, frames of 0.04-0.125 s, tests/test_viscous.c box_gravity_shifting) the mechanical
-   energy rose from one frame to the next in 8 of 16 runs at 0.2 h^2 / dim, by up to 8.6 % (2D)
+   gravity's hydrostatic pressure that push puts energy in. In the vortex box under gravity (2D
+   25 x 25 and 3D 20 x 20 x 6, A = 4, frames of 0.04-0.125 s, tests/test_viscous.c
+   box_gravity_shifting) the mechanical energy rose from one frame to the next in 8 of 16 runs at 0.2 h^2 / dim, by up to 8.6 % (2D)
    and 20 % (3D) of the start's kinetic energy, and in none at 0.1 h^2 / dim. WCSPH carries its
    density: its particles move with their density and pressure, and it rose in none of 6 such
    runs. Shifting before the density summation instead (so that the same step's solve removes
