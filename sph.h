@@ -8658,18 +8658,17 @@ static sph_status sph__rate_cache(sph_world* w, sph__ctx* c) {
    unchanged below that Mach number. IISPH and DFSPH (every summation density) take half that
    (SPH__SHIFT_DMAX_SUMMED): the shift moves mass without work, and a summed density turns what it
    compresses into pressure that the next solve spends pushing the particles apart; against
-   gravity's hydrostatic pressure that push puts energy in. In the vortex box under gravity (2D
-   25 x 25 and 3D 20 x 20 x 6, A = 4, frames of 0.04-0.125 s, tests/test_viscous.c
-   box_gravity_shifting) the mechanical energy rose from one frame to the next in 8 of 16 runs at 0.2 h^2 / dim, by up to 8.6 % (2D)
-   and 20 % (3D) of the start's kinetic energy, and in none at 0.1 h^2 / dim. WCSPH carries its
-   density: its particles move with their density and pressure, and it rose in none of 6 such
-   runs. Shifting before the density summation instead (so that the same step's solve removes
-   the compression) was worse: at 0.2 h^2 / dim the 3D box under gravity gained 34 % of its
-   start's kinetic energy in a frame (IISPH, 0.05 s frames), against 7.5 % shifting after the
-   solve. Measured in the vortex boxes without gravity, the kinetic energy's decay over its exact
-   rate in 2D (tests/test_viscous.c): IISPH 3.3 -> 2.0, DFSPH 3.2 -> 2.1, WCSPH 4.2 -> 1.13
-   (IISPH and DFSPH 1.7 at 0.2 h^2 / dim); the 3D box's kinetic energy after 0.5 s (exact 0.82
-   of its start): IISPH 0.48 -> 0.54, DFSPH 0.48 -> 0.54, WCSPH 0.53 -> 0.80. The frame-end mean
+   gravity's hydrostatic pressure that push puts energy in. In the vortex box under gravity (2D 25 x
+   25 and 3D 20 x 20 x 6, A = 4, frames of 0.04-0.125 s, tests/test_viscous.c box_gravity_shifting)
+   the mechanical energy rose from one frame to the next in 8 of 16 runs at 0.2 h^2 / dim, by up to
+   8.6 % (2D) and 20 % (3D) of the start's kinetic energy, and in none at 0.1 h^2 / dim. WCSPH
+   carries its density: its particles move with their density and pressure, and it rose in none of 6
+   such runs. Shifting before the density summation instead (so that the same step's solve removes
+   the compression) was worse: at 0.2 h^2 / dim the 3D box under gravity gained 34 % of its start's
+   kinetic energy in a frame (IISPH, 0.05 s frames), against 7.5 % shifting after the solve.
+   Measured in the vortex boxes without gravity, the kinetic energy's decay over its exact rate in
+   2D (tests/test_viscous.c): IISPH 3.3 -> 2.0, DFSPH 3.2 -> 2.1, WCSPH 4.2 -> 1.13 (IISPH and DFSPH
+   1.7 at 0.2 h^2 / dim); the 3D box's kinetic energy after 0.5 s (exact 0.82 of its start): IISPH 0.48 -> 0.54, DFSPH 0.48 -> 0.54, WCSPH 0.53 -> 0.80. The frame-end mean
    density error (summed afresh) of IISPH and DFSPH is 0.3-0.4 % (2D) and 0.7-1.1 % (3D) against
    0.2-0.37 % unshifted (the next solve removes what the shift compressed). */
 #define SPH__SHIFT_DMAX SPH__R(0.2) /* dim times the bound on A h U dt [h^2]: sph__stage_shift */
