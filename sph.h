@@ -8668,9 +8668,10 @@ static sph_status sph__rate_cache(sph_world* w, sph__ctx* c) {
    kinetic energy in a frame (IISPH, 0.05 s frames), against 7.5 % shifting after the solve.
    Measured in the vortex boxes without gravity, the kinetic energy's decay over its exact rate in
    2D (tests/test_viscous.c): IISPH 3.3 -> 2.0, DFSPH 3.2 -> 2.1, WCSPH 4.2 -> 1.13 (IISPH and DFSPH
-   1.7 at 0.2 h^2 / dim); the 3D box's kinetic energy after 0.5 s (exact 0.82 of its start): IISPH 0.48 -> 0.54, DFSPH 0.48 -> 0.54, WCSPH 0.53 -> 0.80. The frame-end mean
-   density error (summed afresh) of IISPH and DFSPH is 0.3-0.4 % (2D) and 0.7-1.1 % (3D) against
-   0.2-0.37 % unshifted (the next solve removes what the shift compressed). */
+   1.7 at 0.2 h^2 / dim); the 3D box's kinetic energy after 0.5 s (exact 0.82 of its start): IISPH
+   0.48 -> 0.54, DFSPH 0.48 -> 0.54, WCSPH 0.53 -> 0.80. The frame-end mean density error (summed
+   afresh) of IISPH and DFSPH is 0.3-0.4 % (2D) and 0.7-1.1 % (3D) against 0.2-0.37 % unshifted (the
+   next solve removes what the shift compressed). */
 #define SPH__SHIFT_DMAX SPH__R(0.2) /* dim times the bound on A h U dt [h^2]: sph__stage_shift */
 #define SPH__SHIFT_DMAX_SUMMED SPH__R(0.1) /* the same for a summation density (IISPH, DFSPH) */
 static sph_status sph__shift_reserve(sph_world* w) {
