@@ -1319,6 +1319,9 @@ typedef struct sph_stats {
                                  kinetic energy since the forcing stopped [J] (the energy check,
                                  sph__energy_check)                                              */
     long unforced_steps;      /* steps since then (0: forced, or none yet)                       */
+    int enclosed;             /* PCISPH, IISPH, DFSPH with walls that copy the fluid's pressure:
+                                 1 once a step found the fluid enclosed, with no free surface
+                                 (sph__enclosed); its walls keep zero pressure from then on  */
     uint64_t neighbor_builds; /* neighbour searches (sort by cell and list build) since
                                  sph_world_init, in the steps kept (sph_advance undoes a
                                  rolled-back step's with it): one a step with neighbor_skin 0,
@@ -1662,8 +1665,9 @@ SPHDEF void sph_world_def_pcisph(sph_world_def* def, int enhanced);
    error is below def.tolerance on average (and def.tolerance_max at most, if set), after
    def.min_iterations and at most def.max_iterations. w->stats.iterations and .solver_error
    report the solve. A fluid without a free surface (a closed box it fills) is corrected with
-   zero wall pressure whatever def.boundary_pressure says (w.b_p is 0 in such a step): walls that
-   copy the fluid's pressure make its pressure force no constraint force there. */
+   zero wall pressure whatever def.boundary_pressure says (w.b_p is 0 in such a step), from the
+   first step that finds it so on (w->stats.enclosed): walls that copy the fluid's pressure make
+   its pressure force no constraint force there. */
 SPHDEF sph_status sph_step_pcisph(sph_world* w, sph_real dt);
 
 /* ============================================================================================== */
@@ -7960,15 +7964,24 @@ static sph_real sph__standing_keep(const sph_world* w) {
    tests/test_scenes.c's and tests/test_reliability.c's vortex boxes), on tank surfaces mostly
    0.4-1.1 dx. A wrong call turned the walls back to the copied pressure every few steps: IISPH's
    3D box needed 17 retries and DFSPH's kinetic energy rose by 0.2 of its start in one frame.
-   With ZERO walls the wall pressure anchors the level and nothing changes. Deterministic: one
-   serial pass, stopped at the anchor count; the neighbour offsets are summed only for the
+   With ZERO walls the wall pressure anchors the level and nothing changes.
+   The decision is kept once made (w->stats.enclosed, carried by sph_advance's rollback and by
+   sph_world_save). A fluid that fills a sealed box under gravity settles into the floor's wall
+   lattice and its top layer leaves the lid: in a 3D box of 1 x 1 x 0.3 m at dx = 0.05 the whole
+   top layer (120 particles, against an anchor of 36) turned into surface within one step at t =
+   0.4 s, the walls went back to the copied pressure, and enhanced PCISPH failed at every step
+   size (a particle at 139 m/s after 28 retries). Kept on zero wall pressure it runs on; so does
+   every solver where a fluid that filled its box later opens a gap, at zero wall pressure's
+   accuracy (the tank's hydrostatic pressure within 1.6 % instead of 1 %, README). Deterministic:
+   one serial pass, stopped at the anchor count; the neighbour offsets are summed only for the
    particles short of neighbours. */
-static int sph__enclosed(const sph_world* w, const sph__ctx* c) {
+static int sph__enclosed(sph_world* w, const sph__ctx* c) {
     const int D = w->dim;
     const double anchor = fmax(1.0, 0.2 * pow((double)w->n, (D - 1.0) / D));
     const double need = 0.85 * (double)w->priv.full_count;
     size_t i, surface = 0;
     if (w->def.boundary_pressure == SPH_BP_ZERO || w->nb == 0 || w->n == 0) return 0;
+    if (w->stats.enclosed) return 1;
     for (i = 0; i < w->n && (double)surface < anchor; ++i) {
         const size_t nf = w->priv.ff.count[i], nw = w->priv.fb.count[i];
         const sph_real* xi = c->x + i * (size_t)D;
@@ -7989,7 +8002,8 @@ static int sph__enclosed(const sph_world* w, const sph__ctx* c) {
         for (k = 0; k < D; ++k) s2 += s[k] * s[k];
         surface += nf + nw == 0 || sqrt(s2) > 0.3 * (double)(nf + nw) * (double)w->dx;
     }
-    return (double)surface < anchor;
+    w->stats.enclosed = (double)surface < anchor;
+    return w->stats.enclosed;
 }
 
 /* Divergence of relaxed Jacobi. The weight converges only while omega lambda_max(D^-1 A) < 2,
@@ -11989,7 +12003,7 @@ typedef struct sph__sink {
     int err;
 } sph__sink;
 
-#define SPH__SAVE_VERSION 2u /* 2: sph_stats.potential_energy */
+#define SPH__SAVE_VERSION 3u /* 2: sph_stats.potential_energy; 3: sph_stats.enclosed */
 #define SPH__FNV_OFFSET 14695981039346656037ull
 #define SPH__FNV_PRIME 1099511628211ull
 
