@@ -488,10 +488,10 @@ int main(void) {
    phase filling the tank to its lid, within 0.2 s with it 0.1 m below the lid), held 0.5; below
    0.35 the first step now refuses it (SPH__CONTINUITY_RATIO_MIN). With particle density and the
    lighter phase 0.1 m below the lid, ratio 0.1 runs the whole second (2D 109 retries, 3D 63; no
-   particle out, energy at most +0.17 % of M g H). Not with fluid that fills
-   its closed walls: there the correction runs with zero wall pressure (sph__enclosed), and
-   enhanced PCISPH fails in 3D even with equal densities (a tank full of water at rest: 0.28 s;
-   the dam break at 0.1, 0.01 and 0.001 within 0.16-0.26 s; in 2D they run, with 160-600
+   particle out, energy at most +0.17 % of M g H). With fluid that fills its closed walls the
+   correction runs with zero wall pressure (sph__enclosed): in 3D enhanced PCISPH holds a tank
+   full of water at rest for 1 s and the full tank's dam break at ratio 0.1 for 1 s (no retry),
+   but fails it at 0.01 and 0.001 (0.56 s and 0.58 s, reported; in 2D they ran, with 160-600
    retries); WCSPH with particle density and the multiphase gradient runs the full tank's dam
    break at 0.1 and 0.01 in 2D and 3D (energy at most +0.05 % of M g H, no particle out) and fails
    at 0.001 (0.36 s, 0.38 s): for such ratios, and for gases, use the compressible step below.
