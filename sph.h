@@ -6727,7 +6727,9 @@ static void sph__stage_interact(sph_world* w, const sph__ctx* c, int flags, sph_
         SPH__LOOP(D, SPH__PRESSURE | SPH__SET | SPH__CACHED, F); break;                            \
     case (F) * 512 + D * 128 + SPH__RATE: SPH__LOOP(D, SPH__RATE, F); break;                       \
     case (F) * 512 + D * 128 + (SPH__RATE | SPH__CACHED):                                          \
-        SPH__LOOP(D, SPH__RATE | SPH__CACHED, F); break;
+        SPH__LOOP(D, SPH__RATE | SPH__CACHED, F); break;                                           \
+    case (F) * 512 + D * 128 + (SPH__RATE | SPH__STORE):                                           \
+        SPH__LOOP(D, SPH__RATE | SPH__STORE, F); break;
         switch (fast * 512 + c->dim * 128 + flags) {
             SPH__CASES(1, 0)
             SPH__CASES(2, 0)
@@ -9479,6 +9481,11 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt, double dt_prev) {
        the error has fallen by less than 2 % over 5 iterations (from the 10th on) while above
        the tolerance, then 2. */
     int smooth = w->def.pressure_smoothing < 1;
+    /* with continuity the solve's passes all run at the same positions: the first rate pass
+       keeps grad W of every pair (sph__rate_cache) and the later ones read it, the same values
+       (so the same bits); the symmetric gradient's cached form would read p / rho^2 (c.pr2),
+       which this solve does not keep, so its pressure pass evaluates the kernel */
+    const int cached_p = !summation && w->def.pressure_grad != SPH_PGRAD_SYMMETRIC;
     uint64_t sorts;
     sph__ctx c;
     sph_status s;
@@ -9518,6 +9525,10 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt, double dt_prev) {
         return s;
     }
     sph__ctx_init(w, &c);
+    if (!summation && (s = sph__rate_cache(w, &c)) != SPH_OK) {
+        if (verlet) sph__undo_drift(w, w->priv.xp, sorts);
+        return s;
+    }
     /* delta-SPH needs a speed of sound, which PCISPH does not have (Enhanced PCISPH 2018 sec. 3.2.1
        leaves it open). The phase's c0 would make the explicit diffusion unstable at PCISPH's large
        steps (delta h c0 dt / h^2 grows with dt); c = cfl h / dt is the speed for which dt is the
@@ -9636,7 +9647,8 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt, double dt_prev) {
         } else {
             sph__ctx cr = c;
             cr.v = w->priv.vp;
-            sph__stage_interact(w, &cr, SPH__RATE, NULL);
+            sph__stage_interact(w, &cr, it == 0 ? SPH__RATE | SPH__STORE : SPH__RATE | SPH__CACHED,
+                                NULL);
             SPH__OMP_FOR(w->n)
             for (i = 0; i < (sph__idx)w->n; ++i) w->rho[i] = sph__rho_floor(&c, (size_t)i, w->priv.rho_n[i] + dt * w->drho[i]);
         }
@@ -9687,7 +9699,8 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt, double dt_prev) {
             if (smooth == 1) sph__copy(w->p, w->priv.pr2, w->n * sizeof(sph_real));
             if (smooth == 2) cq.p = w->priv.pr2;
             if (w->nb > 0) sph__stage_wall(w, &cq, SPH__WALL_PRESSURE);
-            sph__stage_interact(w, &cq, SPH__PRESSURE | SPH__SET, w->priv.ap);
+            sph__stage_interact(w, &cq, cached_p ? SPH__PRESSURE | SPH__SET | SPH__CACHED
+                                                 : SPH__PRESSURE | SPH__SET, w->priv.ap);
         }
         ++it;
         if ((it >= w->def.min_iterations && err <= (double)w->def.tolerance &&
@@ -9710,7 +9723,7 @@ static sph_status sph__step_pcisph(sph_world* w, sph_real dt, double dt_prev) {
     if (!summation) {
         sph__ctx cr = c;
         cr.v = w->priv.vp;
-        sph__stage_interact(w, &cr, SPH__RATE, NULL);
+        sph__stage_interact(w, &cr, SPH__RATE | SPH__CACHED, NULL);
         SPH__OMP_FOR(w->n)
         for (i = 0; i < (sph__idx)w->n; ++i) w->rho[i] = sph__rho_floor(&c, (size_t)i, w->priv.rho_n[i] + dt * w->drho[i]);
     }
